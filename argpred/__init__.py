@@ -1,0 +1,1 @@
+"""Argument prediction CNN (flax/optax). Not built yet: see issue 5."""

@@ -1,0 +1,169 @@
+"""Contact and motion on the raster, the emulator's hot path.
+
+Raster lines are uint32 bit words. An object's mask has at most two runs per row and
+per column (tables made at load time), so it is cheap to test against an occupancy
+bitmap of everything else:
+
+- a move left/right/up/down is solved in closed form: per mask line, the first
+  occupied pixel ahead of each run (count-leading-zeros on the bit words) gives how
+  far the object can slide; up/down use the transposed (per-column) tables;
+- a move toward a point samples its path (whole-pixel offsets, at most one pixel per
+  axis per step) and stops before the first sample that collides or leaves the raster.
+
+Both agree with the reference interpreter's literal pixel-set sweep (tested).
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from vccjax.config import VCCConfig
+from vccjax.state import SceneConst, VCCState
+
+_ONE = np.uint32(1)
+
+
+def low_bits(n: jax.Array) -> jax.Array:
+    """uint32 with the n lowest bits set, n in [0, 32] (XLA shifts by >= 32 give 0)."""
+    return jnp.left_shift(_ONE, n.astype(jnp.uint32)) - _ONE
+
+
+def run_bits(lo: jax.Array, hi: jax.Array, cfg: VCCConfig) -> jax.Array:
+    """Bit words (..., W) of the run [lo, hi]; empty when lo > hi."""
+    start = jnp.arange(cfg.words, dtype=jnp.int32) * 32
+    a = jnp.clip(lo[..., None] - start, 0, 32)
+    b = jnp.clip(hi[..., None] + 1 - start, 0, 32)
+    return low_bits(b) & ~low_bits(a)
+
+
+def _lines(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int):
+    """Per object: its mask lines' raster indices (N, K) and runs (N, K, 2) lo, hi, now.
+
+    axis 0: lines are rows, runs are columns; axis 1: lines are columns, runs are rows.
+    """
+    table, start = (c.runs, c.bbox[:, 0]) if axis == 0 else (c.cruns, c.bbox[:, 2])
+    line_off, run_off = (s.offset[:, 1], s.offset[:, 0]) if axis == 0 else (s.offset[:, 0], s.offset[:, 1])
+    lines = (start + line_off)[:, None] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
+    shifted = table + run_off[:, None, None]
+    return lines, shifted[..., 0::2], shifted[..., 1::2]
+
+
+def occupancy(
+    c: SceneConst, s: VCCState, cfg: VCCConfig, exclude, axis: int = 0, imagined: bool = True
+) -> jax.Array:
+    """(R, W) bit lines of every alive object except slot `exclude`, plus the imagined one.
+
+    Objects never overlap (scenes are validated, motion and imagination keep it so), so
+    adding disjoint bit words is OR-ing them.
+    """
+    lines, lo, hi = _lines(c, s, cfg, axis)
+    keep = s.alive & (jnp.arange(cfg.n_max) != exclude)
+    bits = jnp.sum(run_bits(lo, hi, cfg), axis=2, dtype=jnp.uint32)  # (N, K, W)
+    bits = jnp.where(keep[:, None, None], bits, jnp.uint32(0))
+    occ = jnp.zeros((cfg.raster, cfg.words), jnp.uint32)
+    occ = occ.at[jnp.clip(lines, 0, cfg.raster - 1)].add(bits)
+    if imagined:
+        im = s.imag_runs if axis == 0 else s.imag_cruns
+        occ = occ | run_bits(im[:, 0], im[:, 1], cfg)
+    return occ
+
+
+def contains(c: SceneConst, s: VCCState, cfg: VCCConfig, point: jax.Array) -> jax.Array:
+    """(N,) whether each alive object's mask holds the pixel of `point` (position units)."""
+    col = jnp.minimum(point[0] // cfg.sub, cfg.raster - 1)
+    row = jnp.minimum(point[1] // cfg.sub, cfg.raster - 1)
+    k = row - (c.bbox[:, 0] + s.offset[:, 1])
+    ok = (k >= 0) & (k < cfg.mask_rows) & s.alive
+    runs = c.runs[jnp.arange(cfg.n_max), jnp.clip(k, 0, cfg.mask_rows - 1)]
+    x = col - s.offset[:, 0]
+    inside = ((x >= runs[:, 0]) & (x <= runs[:, 1])) | ((x >= runs[:, 2]) & (x <= runs[:, 3]))
+    return ok & inside
+
+
+def imagined_runs(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> tuple[jax.Array, jax.Array]:
+    """Per-row and per-column runs (R, 2) of an imagined circle (kind 0) or hline (kind 1),
+    with the exact integer tests of geometry.imagined_pixels."""
+    u, sub, r = cfg.units, cfg.sub, cfg.raster
+    centres = jnp.arange(r, dtype=jnp.int32) * sub + sub // 2
+    dy = centres - at[1]
+    dx = centres - at[0]
+    fp = jnp.where(
+        kind == 0,
+        16 * (dx[None, :] ** 2 + dy[:, None] ** 2) <= u * u,
+        jnp.broadcast_to((100 * jnp.abs(dy) <= u)[:, None], (r, r)),
+    )  # (rows, cols)
+
+    def runs(m):  # each line of m is one run or empty (both footprints are convex)
+        any_ = m.any(axis=1)
+        lo = jnp.argmax(m, axis=1)
+        hi = r - 1 - jnp.argmax(m[:, ::-1], axis=1)
+        return jnp.stack([jnp.where(any_, lo, 1), jnp.where(any_, hi, 0)], axis=1).astype(jnp.int32)
+
+    return runs(fp), runs(fp.T)
+
+
+def _ctz(x: jax.Array) -> jax.Array:
+    """Count trailing zeros of nonzero uint32 words."""
+    return 31 - jax.lax.clz(x & (~x + _ONE)).astype(jnp.int32)
+
+
+def slide(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int, sign: int) -> VCCState:
+    """Carry the held object straight until contact or the raster edge (closed form).
+
+    axis 0 moves along x (left/right), axis 1 along y (up/down); sign is +1 or -1.
+    """
+    i = s.held
+    r = cfg.raster
+    occ = occupancy(c, s, cfg, exclude=i, axis=0 if axis == 0 else 1)
+    lines, lo, hi = _lines(c, s, cfg, 0 if axis == 0 else 1)
+    lines, lo, hi = lines[i], lo[i], hi[i]  # (K,), (K, 2), (K, 2)
+    words = occ[jnp.clip(lines, 0, r - 1)][:, None, :]  # (K, 1, W)
+    start = jnp.arange(cfg.words, dtype=jnp.int32) * 32
+    if sign > 0:  # first occupied pixel after hi, else the edge at R
+        ahead = words & ~low_bits(jnp.clip(hi[..., None] + 1 - start, 0, 32))
+        first = jnp.min(jnp.where(ahead != 0, start + _ctz(ahead), r), axis=-1)
+        gap = first - hi - 1
+    else:  # last occupied pixel before lo, else the edge at -1
+        behind = words & low_bits(jnp.clip(lo[..., None] - start, 0, 32))
+        last = jnp.max(jnp.where(behind != 0, start + 31 - jax.lax.clz(behind).astype(jnp.int32), -1), axis=-1)
+        gap = lo - last - 1
+    shift = jnp.min(jnp.where(lo <= hi, gap, r))
+    delta = jnp.zeros(2, jnp.int32).at[axis].set(sign * shift)
+    return s.replace(offset=s.offset.at[i].add(delta), hand=s.hand + delta * cfg.sub)
+
+
+def toward_path(start: jax.Array, target: jax.Array, cfg: VCCConfig) -> jax.Array:
+    """(R + 1, 2) pixel offsets from `start` toward `target` (position units): the whole-pixel
+    displacement rounded half up, sampled with at most one pixel per axis per step; samples
+    past arrival repeat the last."""
+    sub = cfg.sub
+    dp = (2 * (target - start) + sub) // (2 * sub)
+    n = jnp.max(jnp.abs(dp))
+    t = jnp.minimum(jnp.arange(cfg.raster + 1, dtype=jnp.int32), n)[:, None]
+    nn = jnp.maximum(n, 1)
+    return (2 * t * dp[None, :] + nn) // (2 * nn)
+
+
+def carry_toward(c: SceneConst, s: VCCState, cfg: VCCConfig, target: jax.Array) -> VCCState:
+    """Carry the held object toward `target` until contact or arrival, testing every sample."""
+    i = s.held
+    r = cfg.raster
+    path = toward_path(c.base[i] + s.offset[i] * cfg.sub, target, cfg)
+    occ = occupancy(c, s, cfg, exclude=i)
+    total = s.offset[i][None, :] + path  # (P, 2) offsets since load
+    bb = c.bbox[i]
+    out = (
+        (bb[0] + total[:, 1] < 0) | (bb[1] + total[:, 1] >= r)
+        | (bb[2] + total[:, 0] < 0) | (bb[3] + total[:, 0] >= r)
+    )
+    rows = bb[0] + total[:, 1:2] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
+    occ_rows = occ[jnp.clip(rows, 0, r - 1)]  # (P, K, W)
+    runs = c.runs[i][None] + total[:, 0, None, None]  # (P, K, 4)
+    bits = run_bits(runs[..., 0::2], runs[..., 1::2], cfg)  # (P, K, 2, W)
+    hit = jnp.any((bits & occ_rows[:, :, None, :]) != 0, axis=(1, 2, 3))
+    bad = out | hit
+    first_bad = jnp.where(bad.any(), jnp.argmax(bad), path.shape[0])
+    delta = path[jnp.maximum(first_bad - 1, 0)]
+    return s.replace(offset=s.offset.at[i].add(delta), hand=s.hand + delta * cfg.sub)

@@ -1,0 +1,155 @@
+"""Scenes of the tabletop world: objects, an optional pointer, validation, JSON and comparison."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.errors import SceneError
+from vccjax.geometry import object_pixels
+from vccjax.instructions import COLORS, SHAPES
+
+
+@dataclasses.dataclass(frozen=True)
+class SceneObject:
+    shape: str
+    color: str
+    x: float
+    y: float
+    width: float
+
+    def __post_init__(self) -> None:
+        if self.shape not in SHAPES:
+            raise SceneError(f"unknown shape {self.shape!r}; expected one of {list(SHAPES)}")
+        if self.color not in COLORS:
+            raise SceneError(f"unknown color {self.color!r}; expected one of {list(COLORS)}")
+        for name in ("x", "y", "width"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float, np.floating, np.integer)) or not np.isfinite(v):
+                raise SceneError(f"object {name} must be a finite number, got {v!r}")
+
+    def describe(self) -> str:
+        return f"{self.color} {self.shape} at ({self.x:.3f}, {self.y:.3f}) width {self.width:.3f}"
+
+
+@dataclasses.dataclass(frozen=True)
+class Scene:
+    """Objects on the unit square (x right, y down) and the teacher's pointer, if any."""
+
+    objects: tuple[SceneObject, ...]
+    pointer: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "objects", tuple(self.objects))
+        if self.pointer is not None:
+            object.__setattr__(self, "pointer", (float(self.pointer[0]), float(self.pointer[1])))
+
+    # ---- validation -------------------------------------------------------------------
+    def validate(self, cfg: VCCConfig = DEFAULT_CONFIG) -> Scene:
+        """Raise SceneError unless every object is inside the workspace and none overlap."""
+        if len(self.objects) > cfg.n_max:
+            raise SceneError(f"scene has {len(self.objects)} objects; at most {cfg.n_max} fit (n_max)")
+        for i, o in enumerate(self.objects):
+            if not 0 < o.width <= cfg.max_width:
+                raise SceneError(f"object {i} ({o.describe()}): width must be in (0, {cfg.max_width}]")
+            h = o.width / 2
+            if o.x - h < 0 or o.x + h > 1 or o.y - h < 0 or o.y + h > 1:
+                raise SceneError(f"object {i} ({o.describe()}) lies outside the workspace")
+        if self.pointer is not None:
+            px, py = self.pointer
+            if not (0 <= px <= 1 and 0 <= py <= 1):
+                raise SceneError(f"pointer {self.pointer} lies outside the workspace")
+        occupied: dict[tuple[int, int], int] = {}
+        for i, o in enumerate(self.objects):
+            rows, cols = object_pixels(o.shape, o.width, to_units(o.x, cfg), to_units(o.y, cfg), cfg)
+            for rc in zip(rows.tolist(), cols.tolist()):
+                j = occupied.setdefault(rc, i)
+                if j != i:
+                    raise SceneError(
+                        f"objects {j} ({self.objects[j].describe()}) and {i} ({o.describe()}) overlap"
+                    )
+        return self
+
+    # ---- JSON -------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        d: dict = {"objects": [dataclasses.asdict(o) for o in self.objects]}
+        if self.pointer is not None:
+            d["pointer"] = list(self.pointer)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "scene") -> Scene:
+        if not isinstance(d, dict) or not isinstance(d.get("objects"), list):
+            raise SceneError(f"{where}: expected an object with an 'objects' list")
+        objs = []
+        for i, od in enumerate(d["objects"]):
+            if not isinstance(od, dict):
+                raise SceneError(f"{where}: object {i} is not a mapping")
+            missing = {"shape", "color", "x", "y", "width"} - set(od)
+            if missing:
+                raise SceneError(f"{where}: object {i} lacks {sorted(missing)}")
+            try:
+                objs.append(SceneObject(od["shape"], od["color"], od["x"], od["y"], od["width"]))
+            except SceneError as e:
+                raise SceneError(f"{where}: object {i}: {e}") from None
+        ptr = d.get("pointer")
+        if ptr is not None and (not isinstance(ptr, (list, tuple)) or len(ptr) != 2):
+            raise SceneError(f"{where}: pointer must be [x, y]")
+        return cls(tuple(objs), None if ptr is None else (float(ptr[0]), float(ptr[1])))
+
+    def save(self, path: str | Path) -> None:
+        Path(path).write_text(json.dumps(self.to_dict(), indent=1))
+
+    @classmethod
+    def load(cls, path: str | Path) -> Scene:
+        p = Path(path)
+        try:
+            d = json.loads(p.read_text())
+        except FileNotFoundError:
+            raise SceneError(f"{p}: no such scene file") from None
+        except (json.JSONDecodeError, UnicodeDecodeError) as e:
+            raise SceneError(f"{p}: not a JSON scene file ({e})") from None
+        return cls.from_dict(d, where=str(p))
+
+
+def to_units(v: float, cfg: VCCConfig) -> int:
+    """A coordinate in [0, 1] as integer position units (round half to even)."""
+    return int(np.rint(float(v) * cfg.units))
+
+
+def scenes_match(a: Scene, b: Scene, tau: float) -> bool:
+    """Spec section 7: same object count, matched one to one by shape, color and center within tau."""
+    if len(a.objects) != len(b.objects):
+        return False
+    n = len(a.objects)
+    ok = [
+        [
+            oa.shape == ob.shape
+            and oa.color == ob.color
+            and (oa.x - ob.x) ** 2 + (oa.y - ob.y) ** 2 <= tau * tau
+            for ob in b.objects
+        ]
+        for oa in a.objects
+    ]
+    match_b = [-1] * n
+
+    def augment(i: int, seen: list[bool]) -> bool:
+        for j in range(n):
+            if ok[i][j] and not seen[j]:
+                seen[j] = True
+                if match_b[j] < 0 or augment(match_b[j], seen):
+                    match_b[j] = i
+                    return True
+        return False
+
+    return all(augment(i, [False] * n) for i in range(n))
+
+
+def same_objects(a: Sequence[SceneObject], b: Sequence[SceneObject]) -> bool:
+    """Exact equality of object lists (order included), for determinism checks."""
+    return tuple(a) == tuple(b)

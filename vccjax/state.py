@@ -1,0 +1,172 @@
+"""The machine's working memories as fixed-shape arrays (flax.struct pytrees).
+
+`SceneConst` holds what a scene fixes (shapes, widths, masks at load time, the
+pointer) and is shared by every program prefix run on that scene; `VCCState` holds
+what instructions change. Object masks are not stored: an object's mask is its
+load-time mask (two column runs per row) shifted by its whole-pixel offset.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from flax import struct
+
+from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.geometry import mask_intervals, object_pixels
+from vccjax.instructions import COLORS, SHAPES
+from vccjax.scene import Scene, SceneObject, to_units
+
+
+@struct.dataclass
+class SceneConst:
+    n: jax.Array  # () number of objects
+    shape: jax.Array  # (N,) shape index
+    color: jax.Array  # (N,) initial color index
+    width: jax.Array  # (N,) float32 width (unit square)
+    base: jax.Array  # (N, 2) centre at load, position units (x, y)
+    runs: jax.Array  # (N, K, 4) column runs (lo1, hi1, lo2, hi2) per mask row, from row bbox[0]
+    cruns: jax.Array  # (N, K, 4) row runs per mask column, from column bbox[2]
+    bbox: jax.Array  # (N, 4) mask rows/cols at load: rmin, rmax, cmin, cmax
+    has_pointer: jax.Array  # () bool
+    pointer: jax.Array  # (2,) position units
+
+
+@struct.dataclass
+class VCCState:
+    parsed: jax.Array  # () bool
+    alive: jax.Array  # (N,) bool
+    color: jax.Array  # (N,)
+    offset: jax.Array  # (N, 2) whole-pixel displacement since load (x, y)
+    imag_kind: jax.Array  # () -1 none, 0 circle, 1 hline
+    imag_pos: jax.Array  # (2,)
+    imag_runs: jax.Array  # (R, 2) column run per raster row (lo > hi: empty)
+    imag_cruns: jax.Array  # (R, 2) row run per raster column
+    fovea: jax.Array  # (2,)
+    hist: jax.Array  # (H, 2) fixation history
+    hist_len: jax.Array  # ()
+    hist_idx: jax.Array  # () h
+    hand: jax.Array  # (2,)
+    held: jax.Array  # () slot or -1
+    shape_filter: jax.Array  # () -1 unset
+    color_filter: jax.Array  # () -1 unset
+    attn: jax.Array  # (N,) attended list A (slots, -1 padded)
+    attn_len: jax.Array  # ()
+    stale: jax.Array  # () bool
+    cursor: jax.Array  # () k
+    attended: jax.Array  # () slot or -1
+    failed: jax.Array  # () bool
+    fail_index: jax.Array  # () program index of the failing instruction, -1 if none
+    pc: jax.Array  # () index of the next program instruction
+    in_loop: jax.Array  # () bool
+    loop_active: jax.Array  # () bool: the loop runs at least one iteration
+    body_ops: jax.Array  # (B,)
+    body_args: jax.Array  # (B,)
+    body_len: jax.Array  # ()
+    body_pc0: jax.Array  # () program index of the body's first instruction
+
+
+def load_scene(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG, validate: bool = True) -> SceneConst:
+    """A scene as arrays for the emulator (host side: the shapes are rasterised here, once)."""
+    if validate:
+        scene.validate(cfg)
+    n, k = cfg.n_max, cfg.mask_rows
+    shape = np.zeros(n, np.int32)
+    color = np.zeros(n, np.int32)
+    width = np.zeros(n, np.float32)
+    base = np.zeros((n, 2), np.int32)
+    runs = np.tile(np.array([1, 0, 1, 0], np.int32), (n, k, 1))
+    cruns = runs.copy()
+    bbox = np.zeros((n, 4), np.int32)
+    for i, o in enumerate(scene.objects):
+        shape[i] = SHAPES.index(o.shape)
+        color[i] = COLORS.index(o.color)
+        width[i] = o.width
+        base[i] = to_units(o.x, cfg), to_units(o.y, cfg)
+        rows, cols = object_pixels(o.shape, o.width, int(base[i, 0]), int(base[i, 1]), cfg)
+        _, runs[i] = mask_intervals(rows, cols, k)
+        _, cruns[i] = mask_intervals(cols, rows, k)
+        bbox[i] = rows.min(), rows.max(), cols.min(), cols.max()
+    has_ptr = scene.pointer is not None
+    ptr = (to_units(scene.pointer[0], cfg), to_units(scene.pointer[1], cfg)) if has_ptr else (0, 0)
+    return SceneConst(
+        n=jnp.int32(len(scene.objects)), shape=jnp.asarray(shape), color=jnp.asarray(color),
+        width=jnp.asarray(width), base=jnp.asarray(base),
+        runs=jnp.asarray(runs), cruns=jnp.asarray(cruns), bbox=jnp.asarray(bbox), has_pointer=jnp.bool_(has_ptr),
+        pointer=jnp.asarray(ptr, jnp.int32),
+    )
+
+
+def init_state(cfg: VCCConfig = DEFAULT_CONFIG) -> VCCState:
+    """The machine before `scene_parse`: empty blackboard, fovea and hand at the centre."""
+    n, c = cfg.n_max, cfg.units // 2
+    centre = jnp.array([c, c], jnp.int32)
+    i32 = jnp.int32
+    return VCCState(
+        parsed=jnp.bool_(False), alive=jnp.zeros(n, bool), color=jnp.zeros(n, i32),
+        offset=jnp.zeros((n, 2), i32), imag_kind=i32(-1), imag_pos=jnp.zeros(2, i32),
+        imag_runs=empty_runs(cfg), imag_cruns=empty_runs(cfg), fovea=centre,
+        hist=jnp.zeros((cfg.hist_max, 2), i32).at[0].set(centre), hist_len=i32(1),
+        hist_idx=i32(0), hand=centre, held=i32(-1), shape_filter=i32(-1), color_filter=i32(-1),
+        attn=jnp.full(n, -1, i32), attn_len=i32(0), stale=jnp.bool_(True), cursor=i32(0),
+        attended=i32(-1), failed=jnp.bool_(False), fail_index=i32(-1), pc=i32(0),
+        in_loop=jnp.bool_(False), loop_active=jnp.bool_(False),
+        body_ops=jnp.full(cfg.body_max, -1, i32), body_args=jnp.zeros(cfg.body_max, i32),
+        body_len=i32(0), body_pc0=i32(0),
+    )
+
+
+def empty_runs(cfg: VCCConfig) -> jax.Array:
+    return jnp.tile(jnp.array([1, 0], jnp.int32), (cfg.raster, 1))
+
+
+def stack(trees):
+    """Stack a list of pytrees (scenes or states) along a new leading batch axis."""
+    return jax.tree.map(lambda *xs: jnp.stack(xs), *trees)
+
+
+def unstack(tree, i: int):
+    return jax.tree.map(lambda x: x[i], tree)
+
+
+def centres(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
+    """(N, 2) current object centres in position units."""
+    return c.base + s.offset * cfg.sub
+
+
+def output_scene(c: SceneConst, s: VCCState, cfg: VCCConfig, pointer=None) -> Scene:
+    """The blackboard's real, alive objects as a Scene (host side, one unbatched state)."""
+    cen = np.asarray(centres(c, s, cfg))
+    alive, shape, color, width = (np.asarray(a) for a in (s.alive, c.shape, s.color, c.width))
+    objs = tuple(
+        SceneObject(SHAPES[shape[i]], COLORS[color[i]], float(cen[i, 0]) / cfg.units,
+                    float(cen[i, 1]) / cfg.units, float(width[i]))
+        for i in range(cfg.n_max) if alive[i]
+    )
+    return Scene(objs, pointer)
+
+
+def object_masks(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
+    """(N, R, R) bool masks of the objects on the full raster (dead slots empty)."""
+    r = jnp.arange(cfg.raster)
+    k = r[None, :] - (c.bbox[:, 0] + s.offset[:, 1])[:, None]  # (N, R) mask row per raster row
+    valid = (k >= 0) & (k < cfg.mask_rows) & s.alive[:, None]
+    runs = jnp.take_along_axis(c.runs, jnp.clip(k, 0, cfg.mask_rows - 1)[:, :, None], axis=1)
+    runs = runs + s.offset[:, None, None, 0]
+    col = r[None, None, :]
+    inside = ((col >= runs[..., 0:1]) & (col <= runs[..., 1:2])) | (
+        (col >= runs[..., 2:3]) & (col <= runs[..., 3:4])
+    )
+    return inside & valid[:, :, None]
+
+
+def imagined_mask(s: VCCState, cfg: VCCConfig) -> jax.Array:
+    """(R, R) bool footprint of the imagined object (empty if none)."""
+    col = jnp.arange(cfg.raster)[None, :]
+    return (col >= s.imag_runs[:, 0:1]) & (col <= s.imag_runs[:, 1:2])
+
+
+def grid15(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
+    """(N, 2) cells of the 15x15 grid (cell = floor(position * 14)) of the object centres."""
+    return (centres(c, s, cfg) * 14) // cfg.units
