@@ -89,14 +89,22 @@ class Subroutine:
     name: str
     body: tuple[str, ...]
 
+    def atoms(self, library: Mapping[str, Subroutine]) -> list[str]:
+        return _atoms(self.name, library, 0)
+
     def n_args(self, library: Mapping[str, Subroutine]) -> int:
-        return sum(_n_args(item, library) for item in self.body)
+        return sum(1 for a in self.atoms(library) if arg_domain(a))
 
 
-def _n_args(item: str, library: Mapping[str, Subroutine]) -> int:
-    if item in OP:
-        return 1 if arg_domain(item) else 0
-    return library[item].n_args(library)
+def _atoms(name: str, library: Mapping[str, Subroutine], depth: int) -> list[str]:
+    """The atomic instructions a name stands for (itself, or a subroutine's expansion)."""
+    if name in OP:
+        return [name]
+    if name not in library:
+        raise ProgramSyntaxError(f"unknown instruction or subroutine {name!r}")
+    if depth > 32:
+        raise ProgramSyntaxError(f"subroutine {name} nests more than 32 deep (a cycle?)")
+    return [a for item in library[name].body for a in _atoms(item, library, depth + 1)]
 
 
 def _resolve(name: str, args: list[str], where: int) -> tuple[int, int]:
@@ -121,12 +129,9 @@ def _resolve(name: str, args: list[str], where: int) -> tuple[int, int]:
 def expand(
     items: Sequence[tuple[str, Sequence[str]]],
     library: Mapping[str, Subroutine] | None = None,
-    _depth: int = 0,
 ) -> Program:
     """Expand (name, args) items, where a name may be a subroutine, into an atomic program."""
     library = library or {}
-    if _depth > 32:
-        raise ProgramSyntaxError("subroutines nest more than 32 deep (a cycle?)")
     ops: list[int] = []
     out_args: list[int] = []
     for i, (name, args) in enumerate(items):
@@ -135,19 +140,20 @@ def expand(
             ops.append(op)
             out_args.append(a)
             continue
-        if name not in library:
-            raise ProgramSyntaxError(f"instruction {i}: unknown instruction or subroutine {name!r}")
-        sub = library[name]
-        need = sub.n_args(library)
+        try:
+            atoms = _atoms(name, library, 0)
+        except ProgramSyntaxError as e:
+            raise ProgramSyntaxError(f"instruction {i}: {e}") from None
+        need = sum(1 for a in atoms if arg_domain(a))
         if len(args) != need:
             raise ProgramSyntaxError(
                 f"instruction {i}: subroutine {name} takes {need} argument(s), got {len(args)}"
             )
         it = iter(args)
-        inner = [(item, [next(it) for _ in range(_n_args(item, library))]) for item in sub.body]
-        p = expand(inner, library, _depth + 1)
-        ops.extend(p.ops)
-        out_args.extend(p.args)
+        for atom in atoms:
+            op, a = _resolve(atom, [next(it)] if arg_domain(atom) else [], i)
+            ops.append(op)
+            out_args.append(a)
     return Program(tuple(ops), tuple(out_args))
 
 

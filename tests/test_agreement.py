@@ -1,0 +1,135 @@
+"""Property tests: the JAX emulator (jit, vmap) and the reference agree on every case.
+
+Seeded random scenes and random programs (bigram walks over the reference programs
+with noise, loops included; half of them steered to run deep): the two machines must
+agree on failure, the failing index and the whole final state, which includes the
+output scene exactly (positions are integers, so "within tau" holds a fortiori).
+"""
+
+from __future__ import annotations
+
+import chex
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from conftest import summary_jax, summary_ref
+
+from vccjax import emulator
+from vccjax.config import DEFAULT_CONFIG as CFG
+from vccjax.generate import random_deep_program, random_program, random_scene
+from vccjax.instructions import N_OPS
+from vccjax.reference import RefMachine
+from vccjax.scene import scenes_match
+from vccjax.state import init_state, load_scene, output_scene, stack
+
+LENGTH = 32  # programs are padded to this length: one compiled shape for every case
+BATCH = 500
+
+
+def make_cases(seed: int, n: int):
+    rng = np.random.default_rng(seed)
+    cases = []
+    for _ in range(n):
+        sc = random_scene(rng, (1, 8), pointer=bool(rng.random() < 0.6))
+        if rng.random() < 0.6:
+            prog = random_deep_program(rng, sc, max_len=LENGTH - 4)
+        else:
+            prog = random_program(rng, max_len=LENGTH - 4, noise=0.3)
+        cases.append((sc, prog))
+    return cases
+
+
+def check_cases(cases) -> dict:
+    stats = {"failed": 0, "loops": 0, "moved": 0}
+    for start in range(0, len(cases), BATCH):
+        chunk = cases[start : start + BATCH]
+        chunk = chunk + [chunk[-1]] * (BATCH - len(chunk))  # keep one batch shape
+        consts = stack([load_scene(sc) for sc, _ in chunk])
+        arrays = [p.arrays(LENGTH) for _, p in chunk]
+        ops = jnp.asarray(np.stack([a[0] for a in arrays]))
+        args = jnp.asarray(np.stack([a[1] for a in arrays]))
+        out = jax.device_get(emulator.run_programs(CFG, consts, ops, args))
+        host_consts = jax.device_get(consts)
+        for i, (sc, prog) in enumerate(chunk[: min(BATCH, len(cases) - start)]):
+            ref = RefMachine(sc).run(prog)
+            st = jax.tree.map(lambda x: x[i], out)
+            c = jax.tree.map(lambda x: x[i], host_consts)
+            a, b = summary_ref(ref), summary_jax(st, c)
+            assert a == b, f"case {start + i}: {prog}\nscene {sc}\nref {a}\njax {b}"
+            stats["failed"] += ref.failed
+            stats["loops"] += "loop_end" in prog.text()
+            if not ref.failed:
+                mine = output_scene(c, st, CFG)
+                assert scenes_match(mine, ref.output_scene(), CFG.tau)
+                stats["moved"] += not scenes_match(mine, sc, CFG.tau)
+    return stats
+
+
+def test_jax_and_reference_agree_on_2000_random_cases():
+    stats = check_cases(make_cases(seed=2026, n=2000))
+    # the cases must exercise both outcomes, loops and real changes, or the test proves little
+    assert 200 < stats["failed"] < 1800, stats
+    assert stats["loops"] >= 100, stats
+    assert stats["moved"] >= 300, stats
+
+
+@pytest.mark.slow
+def test_jax_and_reference_agree_on_20000_random_cases():
+    stats = check_cases(make_cases(seed=7, n=20000))
+    assert stats["loops"] >= 1000, stats
+
+
+def test_step_batch_grouped_by_instruction_matches_whole_program_runs():
+    """What the search does: step many states, one instruction group at a time."""
+    cases = make_cases(seed=11, n=256)
+    consts = stack([load_scene(sc) for sc, _ in cases])
+    arrays = [p.arrays(LENGTH) for _, p in cases]
+    ops = np.stack([a[0] for a in arrays])
+    args = jnp.asarray(np.stack([a[1] for a in arrays]))
+    states = stack([init_state(CFG)] * len(cases))
+    for t in range(LENGTH):
+        for op in np.unique(ops[:, t]):
+            if op < 0:
+                continue
+            stepped = emulator.step_batch(CFG, int(op), consts, states, args[:, t])
+            pick = jnp.asarray(ops[:, t] == op)
+            states = jax.tree.map(
+                lambda new, old: jnp.where(pick.reshape((-1,) + (1,) * (new.ndim - 1)), new, old),
+                stepped, states,
+            )
+    whole = emulator.run_programs(CFG, consts, jnp.asarray(ops), args)
+    host_s, host_w, host_c = jax.device_get((states, whole, consts))
+    for i in range(len(cases)):
+        pick = lambda t: jax.tree.map(lambda x: x[i], t)  # noqa: E731
+        assert summary_jax(pick(host_s), pick(host_c)) == summary_jax(pick(host_w), pick(host_c)), i
+
+
+def test_run_batch_shares_one_program_over_scenes():
+    rng = np.random.default_rng(5)
+    scenes = [random_scene(rng, (2, 6), pointer=True) for _ in range(64)]
+    prog = random_deep_program(rng, scenes[0], max_len=20)
+    o, a, _ = prog.arrays(LENGTH)
+    out = jax.device_get(emulator.run_batch(CFG, stack([load_scene(s) for s in scenes]),
+                                            jnp.asarray(o), jnp.asarray(a)))
+    for i, sc in enumerate(scenes):
+        c = jax.device_get(load_scene(sc))
+        assert summary_jax(jax.tree.map(lambda x: x[i], out), c) == summary_ref(RefMachine(sc).run(prog))
+
+
+def test_no_retracing_across_programs_and_scenes():
+    """Different programs and scenes of the same padded shape reuse one trace."""
+    traced = jax.jit(chex.assert_max_traces(emulator._run, n=1), static_argnums=0)
+    rng = np.random.default_rng(3)
+    before = emulator.run_program._cache_size()
+    for _ in range(5):
+        sc = random_scene(rng, (1, 8), pointer=True)
+        o, a, _ = random_deep_program(rng, sc, max_len=20).arrays(LENGTH)
+        c = load_scene(sc)
+        traced(CFG, c, jnp.asarray(o), jnp.asarray(a)).failed.block_until_ready()
+        emulator.run_program(CFG, c, jnp.asarray(o), jnp.asarray(a)).failed.block_until_ready()
+    assert emulator.run_program._cache_size() - before <= 1
+    step_traced = jax.jit(chex.assert_max_traces(emulator.step, n=1), static_argnums=0)
+    s = init_state(CFG)
+    for op in range(N_OPS):  # the op is data: one trace serves every instruction
+        s = step_traced(CFG, c, s, jnp.int32(op), jnp.int32(0))

@@ -1,0 +1,144 @@
+"""The `vcc` command line. User mistakes end in a one-line error and exit code 2."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from vccjax.config import DEFAULT_CONFIG
+from vccjax.errors import VCCError
+
+_SHAPE_CHAR = {"square": "#", "circle": "o", "diamond": "<>", "triangle": "^", "star": "*"}
+
+
+def ascii_scene(scene, cfg=DEFAULT_CONFIG, size: int = 32) -> list[str]:
+    """A scene drawn in characters: each object by its index, the pointer as '+'."""
+    from vccjax.geometry import object_pixels
+    from vccjax.scene import to_units
+
+    grid = np.full((size, size), ".", dtype="<U1")
+    f = cfg.raster // size
+    for i, o in enumerate(scene.objects):
+        rows, cols = object_pixels(o.shape, o.width, to_units(o.x, cfg), to_units(o.y, cfg), cfg)
+        ok = (rows >= 0) & (rows < cfg.raster) & (cols >= 0) & (cols < cfg.raster)
+        grid[rows[ok] // f, cols[ok] // f] = str(i % 10)
+    if scene.pointer is not None:
+        px, py = (min(int(v * size), size - 1) for v in scene.pointer)
+        grid[py, px] = "+"
+    return ["".join(r) for r in grid]
+
+
+def _legend(scene) -> list[str]:
+    return [f"{i}: {o.color:6s} {o.shape:8s} ({o.x:.3f}, {o.y:.3f}) w {o.width:.3f}"
+            for i, o in enumerate(scene.objects)]
+
+
+def _read_program(text: str | None):
+    from vccjax.program import parse
+
+    if text is None:
+        return None
+    path = Path(text)
+    if text.endswith((".vcc", ".txt")) or (path.suffix and path.exists()):
+        if not path.exists():
+            raise VCCError(f"{path}: no such program file")
+        text = path.read_text()
+    return parse(text, body_max=DEFAULT_CONFIG.body_max)
+
+
+def cmd_run(a: argparse.Namespace) -> int:
+    from vccjax.concepts import reference_program
+    from vccjax.emulator import run
+    from vccjax.generate import random_scene
+    from vccjax.reference import run_reference
+    from vccjax.scene import Scene, scenes_match
+    from vccjax.state import load_scene, output_scene
+
+    cfg = DEFAULT_CONFIG
+    program = _read_program(a.program)
+    if program is None:
+        if not a.concept:
+            raise VCCError("give a PROGRAM, or --concept NAME to run its reference program")
+        program = reference_program(a.concept)
+    if a.scene:
+        scene, note = Scene.load(a.scene).validate(cfg), f"scene {a.scene}"
+    else:
+        # a seeded random scene; with --concept, the first seed on which the concept does something
+        for seed in range(a.seed, a.seed + 500):
+            scene = random_scene(np.random.default_rng(seed), a.objects, pointer=True)
+            m = run_reference(program, scene, cfg)
+            if not a.concept or (not m.failed and not scenes_match(m.output_scene(), scene, cfg.tau)):
+                break
+        note = f"random scene, seed {seed}"
+    if a.engine == "reference":
+        m = run_reference(program, scene, cfg)
+        failed, index, reason, out = m.failed, m.fail_index, m.fail_reason, m.output_scene()
+    else:
+        c = load_scene(scene, cfg)
+        st = run(program, c, cfg)
+        failed, index, reason = bool(st.failed), int(st.fail_index), None
+        out = output_scene(c, st, cfg, scene.pointer)
+    print(f"program ({len(program)} instructions): {program}")
+    print(f"{note}; engine: {a.engine}")
+    if failed:
+        step = program.steps()[index]
+        why = f": {reason}" if reason else ""
+        print(f"FAILED at instruction {index} ({step[0]}{'(' + step[1] + ')' if step[1] else ''}){why}")
+        return 1
+    before, after = ascii_scene(scene, cfg), ascii_scene(out, cfg)
+    print(f"{'before':<34}after")
+    for l, r in zip(before, after):
+        print(f"{l}  {r}")
+    print("before:", *_legend(scene), sep="\n  ")
+    print("after:", *_legend(out), sep="\n  ")
+    print("changed" if not scenes_match(out, scene, cfg.tau) else "unchanged")
+    return 0
+
+
+def cmd_concepts(a: argparse.Namespace) -> int:
+    from vccjax.concepts import all_concepts
+
+    for name, p in all_concepts().items():
+        if a.pattern is None or a.pattern.lower() in name.lower():
+            print(f"{len(p):3d}  {name}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="vcc",
+        description="Visual Cognitive Computer toolkit: run cognitive programs on tabletop scenes.",
+    )
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    r = sub.add_parser("run", help="run a program on a scene and print it before and after",
+                       description="Run a VCC program (text like 'scene_parse; fixate(left); ...' "
+                                   "or a .vcc file) on a scene and print it before and after.")
+    r.add_argument("program", nargs="?", help="program text or file (default: the concept's reference program)")
+    r.add_argument("--concept", help="one of the 546 concepts (see `vcc concepts`)")
+    r.add_argument("--scene", help="scene JSON file (default: a seeded random scene)")
+    r.add_argument("--seed", type=int, default=0, help="seed of the random scene (default 0)")
+    r.add_argument("--objects", type=int, default=4, help="objects in the random scene (default 4)")
+    r.add_argument("--engine", choices=["jax", "reference"], default="jax",
+                   help="the JAX emulator (default) or the scalar reference interpreter")
+    r.set_defaults(fn=cmd_run)
+    c = sub.add_parser("concepts", help="list the 546 concepts with their program lengths")
+    c.add_argument("pattern", nargs="?", help="only names containing this")
+    c.set_defaults(fn=cmd_concepts)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.fn(args)
+    except (VCCError, KeyError) as e:
+        msg = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
+        print(f"vcc: error: {msg}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
