@@ -27,42 +27,42 @@ LENGTH = 32  # programs are padded to this length: one compiled shape for every 
 BATCH = 500
 
 
-def make_cases(seed: int, n: int):
+def make_cases(seed: int, n: int, cfg=CFG):
     rng = np.random.default_rng(seed)
     cases = []
     for _ in range(n):
-        sc = random_scene(rng, (1, 8), pointer=bool(rng.random() < 0.6))
+        sc = random_scene(rng, (1, 8), pointer=bool(rng.random() < 0.6), cfg=cfg)
         if rng.random() < 0.6:
-            prog = random_deep_program(rng, sc, max_len=LENGTH - 4)
+            prog = random_deep_program(rng, sc, max_len=LENGTH - 4, cfg=cfg)
         else:
             prog = random_program(rng, max_len=LENGTH - 4, noise=0.3)
         cases.append((sc, prog))
     return cases
 
 
-def check_cases(cases) -> dict:
+def check_cases(cases, cfg=CFG, batch=BATCH) -> dict:
     stats = {"failed": 0, "loops": 0, "moved": 0}
-    for start in range(0, len(cases), BATCH):
-        chunk = cases[start : start + BATCH]
-        chunk = chunk + [chunk[-1]] * (BATCH - len(chunk))  # keep one batch shape
-        consts = stack([load_scene(sc) for sc, _ in chunk])
+    for start in range(0, len(cases), batch):
+        chunk = cases[start : start + batch]
+        chunk = chunk + [chunk[-1]] * (batch - len(chunk))  # keep one batch shape
+        consts = stack([load_scene(sc, cfg) for sc, _ in chunk])
         arrays = [p.arrays(LENGTH) for _, p in chunk]
         ops = jnp.asarray(np.stack([a[0] for a in arrays]))
         args = jnp.asarray(np.stack([a[1] for a in arrays]))
-        out = jax.device_get(emulator.run_programs(CFG, consts, ops, args))
+        out = jax.device_get(emulator.run_programs(cfg, consts, ops, args))
         host_consts = jax.device_get(consts)
-        for i, (sc, prog) in enumerate(chunk[: min(BATCH, len(cases) - start)]):
-            ref = RefMachine(sc).run(prog)
+        for i, (sc, prog) in enumerate(chunk[: min(batch, len(cases) - start)]):
+            ref = RefMachine(sc, cfg).run(prog)
             st = jax.tree.map(lambda x: x[i], out)
             c = jax.tree.map(lambda x: x[i], host_consts)
-            a, b = summary_ref(ref), summary_jax(st, c)
+            a, b = summary_ref(ref), summary_jax(st, c, cfg)
             assert a == b, f"case {start + i}: {prog}\nscene {sc}\nref {a}\njax {b}"
             stats["failed"] += ref.failed
             stats["loops"] += "loop_end" in prog.text()
             if not ref.failed:
-                mine = output_scene(c, st, CFG)
-                assert scenes_match(mine, ref.output_scene(), CFG.tau)
-                stats["moved"] += not scenes_match(mine, sc, CFG.tau)
+                mine = output_scene(c, st, cfg)
+                assert scenes_match(mine, ref.output_scene(), cfg.tau)
+                stats["moved"] += not scenes_match(mine, sc, cfg.tau)
     return stats
 
 
@@ -72,6 +72,16 @@ def test_jax_and_reference_agree_on_2000_random_cases():
     assert 200 < stats["failed"] < 1800, stats
     assert stats["loops"] >= 100, stats
     assert stats["moved"] >= 300, stats
+
+
+@pytest.mark.parametrize("raster", [32, 48, 128])
+def test_agreement_at_other_raster_sizes(raster):
+    """The raster is configurable: one word per row (32), a partial second word (48), four (128)."""
+    from vccjax.config import VCCConfig
+
+    cfg = VCCConfig(raster=raster)
+    stats = check_cases(make_cases(seed=raster, n=150, cfg=cfg), cfg, batch=150)
+    assert stats["moved"] >= 20, stats
 
 
 @pytest.mark.slow
@@ -133,3 +143,36 @@ def test_no_retracing_across_programs_and_scenes():
     s = init_state(CFG)
     for op in range(N_OPS):  # the op is data: one trace serves every instruction
         s = step_traced(CFG, c, s, jnp.int32(op), jnp.int32(0))
+
+
+def test_derived_raster_masks_and_grid_match_the_reference_pixels():
+    """The full-resolution masks derived from the JAX state are the reference's pixel sets,
+    after motion too; the 15x15 grid cell is floor(position * 14)."""
+    from vccjax.state import grid15, imagined_mask, object_masks
+
+    rng = np.random.default_rng(17)
+    checked = 0
+    for _ in range(40):
+        sc = random_scene(rng, (2, 8), pointer=True)
+        prog = random_deep_program(rng, sc, max_len=20, p_fail=0.0)
+        ref = RefMachine(sc).run(prog)
+        if ref.failed:
+            continue
+        c = load_scene(sc)
+        o, a, _ = prog.arrays(LENGTH)
+        st = emulator.run_program(CFG, c, jnp.asarray(o), jnp.asarray(a))
+        masks = np.asarray(object_masks(c, st, CFG))
+        cells = np.asarray(grid15(c, st, CFG))
+        for i, ob in enumerate(ref.objects):
+            want = np.zeros((CFG.raster, CFG.raster), bool)
+            if ob.alive:
+                rows, cols = zip(*ref.pixels(i))
+                want[list(rows), list(cols)] = True
+                assert tuple(cells[i]) == (ob.x * 14 // CFG.units, ob.y * 14 // CFG.units)
+            assert (masks[i] == want).all(), (i, prog)
+        imag = np.zeros((CFG.raster, CFG.raster), bool)
+        for r, col in ref.imagined_set():
+            imag[r, col] = True
+        assert (np.asarray(imagined_mask(st, CFG)) == imag).all()
+        checked += 1
+    assert checked >= 20
