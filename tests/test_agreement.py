@@ -62,6 +62,7 @@ def check_cases(cases, cfg=CFG, batch=BATCH) -> dict:
             if not ref.failed:
                 mine = output_scene(c, st, cfg)
                 assert scenes_match(mine, ref.output_scene(), cfg.tau)
+                mine.validate(cfg)  # objects stay inside the workspace and never overlap
                 stats["moved"] += not scenes_match(mine, sc, cfg.tau)
     return stats
 

@@ -81,6 +81,15 @@ def assert_in_contact(m, i: int, steps: list[tuple[int, int]]) -> None:
     assert any(mask(m, i, dx, dy) & blocked for dx, dy in steps), "the moved object is not in contact"
 
 
+def box_gap(m, i, direction):
+    """Distance from object i's w x w box to the workspace border on one side (>= 0)."""
+    o = m.objects[i]
+    x, y, h = o.x / U, o.y / U, o.width / 2
+    gap = {"left": x - h, "right": 1 - x - h, "up": y - h, "down": 1 - y - h}[direction]
+    assert gap >= 0
+    return gap
+
+
 def mask_extent(m, i: int) -> tuple[int, int, int, int]:
     rows, cols = zip(*mask(m, i))
     return min(rows), max(rows), min(cols), max(cols)
@@ -637,21 +646,11 @@ class TestMoveHandDirection:
         assert not m.failed and m.held == 0
         o = m.objects[0]
         x, y = o.x / U, o.y / U
-        rmin, rmax, cmin, cmax = mask_extent(m, 0)
-        # the mask touches the raster edge (one more pixel would leave it) ...
-        if direction == "left":
-            assert cmin == 0 and y == 0.5
-        elif direction == "right":
-            assert cmax == R - 1 and y == 0.5
-        elif direction == "up":
-            assert rmin == 0 and x == 0.5
-        else:
-            assert rmax == R - 1 and x == 0.5
-        # ... and, for shapes that fill their w x w box's sides, the box edge is within a
-        # pixel of the border (a star's or a triangle's points fall short of the box)
-        if shape in ("square", "circle"):
-            edge = {"left": x - w / 2, "right": 1 - (x + w / 2), "up": y - w / 2, "down": 1 - (y + w / 2)}
-            assert abs(edge[direction]) <= PIXEL
+        # the w x w box stays in the workspace, and one more pixel would take it out
+        edge = {"left": x - w / 2, "right": 1 - (x + w / 2), "up": y - w / 2, "down": 1 - (y + w / 2)}
+        assert 0 <= edge[direction] < PIXEL
+        assert (x, y)[direction in ("left", "right")] == 0.5  # it moved along one axis only
+        m.output_scene().validate()
         assert m.hand == (o.x, o.y)  # the hand moved with the object
         # the displacement is whole pixels
         assert (o.x - C) % SUB == 0 and (o.y - C) % SUB == 0
@@ -678,13 +677,13 @@ class TestMoveHandDirection:
     def test_ignores_objects_off_the_path(self):
         sc = scene(obj("square", "red", 0.5, 0.5), obj("circle", "blue", 0.15, 0.25))
         m, _ = run_both("scene_parse; grab_object; move_hand_left", sc)
-        assert mask_extent(m, 0)[2] == 0  # reached the left edge
+        assert box_gap(m, 0, "left") < PIXEL  # reached the left edge
 
     def test_removed_object_does_not_block(self):
         sc = scene(obj("square", "red", 0.5, 0.5), obj("circle", "blue", 0.2, 0.5))
         m, _ = run_both("scene_parse; grab_object; set_shape_attn(circle); top_down_attend; "
                         "remove_from_imagine_buffer; move_hand_left", sc)
-        assert not m.failed and mask_extent(m, 0)[2] == 0
+        assert not m.failed and box_gap(m, 0, "left") < PIXEL
 
     @pytest.mark.parametrize("direction, start", [("down", 0.25), ("up", 0.75)])
     def test_stops_at_imagined_hline(self, direction, start):
@@ -706,7 +705,7 @@ class TestMoveHandDirection:
         sc = scene(obj("square", "red", 0.5, 0.25))
         m, _ = run_both("scene_parse; imagine_object(hline); top_down_attend; move_hand_to_attended_object; "
                         "grab_object; move_hand_right", sc)
-        assert not m.failed and mask_extent(m, 0)[3] == R - 1
+        assert not m.failed and box_gap(m, 0, "right") < PIXEL
 
     def test_stops_at_imagined_circle_then_free_after_reset(self):
         sc = scene(obj("square", "red", 0.85, 0.5))
@@ -719,7 +718,7 @@ class TestMoveHandDirection:
         assert abs((x / U - 0.05) - 0.75) <= 2 * PIXEL  # left edge at the circle's rim
         assert_in_contact(m, 0, [(-1, 0)])
         m, _ = run_both(prog + "; reset_imagination; move_hand_left", sc)
-        assert not m.failed and m.imagined is None and mask_extent(m, 0)[2] == 0
+        assert not m.failed and m.imagined is None and box_gap(m, 0, "left") < PIXEL
 
 
 # =========================================================================================
@@ -755,7 +754,8 @@ class TestMoveHandToPointer:
     def test_stops_at_workspace_edge(self):
         sc = scene(obj("square", "red", 0.5, 0.5), pointer=(0.0, 0.5))
         m, _ = run_both("scene_parse; grab_object; move_hand_to_pointer", sc)
-        assert not m.failed and mask_extent(m, 0)[2] == 0 and m.objects[0].y == C
+        assert not m.failed and 0 <= m.objects[0].x / U - 0.05 < PIXEL and m.objects[0].y == C
+        m.output_scene().validate()
 
     def test_fails_when_not_holding(self):
         sc = scene(obj("square", "red", 0.5, 0.5), pointer=(0.3, 0.3))
@@ -786,7 +786,9 @@ class TestMoveHandToFixateCollision:
 
     def test_stops_at_workspace_edge(self):
         m, _ = run_both("scene_parse; fixate(left); grab_object; move_hand_to_fixate_collision", CENTRED)
-        assert not m.failed and mask_extent(m, 0)[2] == 0 and m.objects[0].y == C
+        assert not m.failed and 0 <= m.objects[0].x / U - m.objects[0].width / 2 < PIXEL
+        assert m.objects[0].y == C
+        m.output_scene().validate()
 
     def test_stops_at_contact_with_fixated_object(self):
         sc = scene(obj("square", "red", 0.5, 0.5), obj("triangle", "blue", 0.2, 0.8))

@@ -8,7 +8,10 @@ bitmap of everything else:
   occupied pixel ahead of each run (count-leading-zeros on the bit words) gives how
   far the object can slide; up/down use the transposed (per-column) tables;
 - a move toward a point samples its path (whole-pixel offsets, at most one pixel per
-  axis per step) and stops before the first sample that collides or leaves the raster.
+  axis per step) and stops before the first sample that collides or leaves the workspace.
+
+"Leaves the workspace" means the object's w x w box leaves the unit square (the test
+scene validation uses, in integer units), precomputed per object as offset bounds.
 
 Both agree with the reference interpreter's literal pixel-set sweep (tested).
 """
@@ -110,7 +113,7 @@ def _ctz(x: jax.Array) -> jax.Array:
 
 
 def slide(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int, sign: int) -> VCCState:
-    """Carry the held object straight until contact or the raster edge (closed form).
+    """Carry the held object straight until contact or the workspace edge (closed form).
 
     axis 0 moves along x (left/right), axis 1 along y (up/down); sign is +1 or -1.
     """
@@ -130,6 +133,9 @@ def slide(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int, sign: int) -> V
         last = jnp.max(jnp.where(behind != 0, start + 31 - jax.lax.clz(behind).astype(jnp.int32), -1), axis=-1)
         gap = lo - last - 1
     shift = jnp.min(jnp.where(lo <= hi, gap, r))
+    off = s.offset[i, axis]
+    room = c.box[i, 2 * axis + 1] - off if sign > 0 else off - c.box[i, 2 * axis]
+    shift = jnp.minimum(shift, room)  # the object's w x w box stays in the workspace
     delta = jnp.zeros(2, jnp.int32).at[axis].set(sign * shift)
     return s.replace(offset=s.offset.at[i].add(delta), hand=s.hand + delta * cfg.sub)
 
@@ -153,12 +159,11 @@ def carry_toward(c: SceneConst, s: VCCState, cfg: VCCConfig, target: jax.Array) 
     path = toward_path(c.base[i] + s.offset[i] * cfg.sub, target, cfg)
     occ = occupancy(c, s, cfg, exclude=i)
     total = s.offset[i][None, :] + path  # (P, 2) offsets since load
-    bb = c.bbox[i]
+    box = c.box[i]
     out = (
-        (bb[0] + total[:, 1] < 0) | (bb[1] + total[:, 1] >= r)
-        | (bb[2] + total[:, 0] < 0) | (bb[3] + total[:, 0] >= r)
+        (total[:, 0] < box[0]) | (total[:, 0] > box[1]) | (total[:, 1] < box[2]) | (total[:, 1] > box[3])
     )
-    rows = bb[0] + total[:, 1:2] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
+    rows = c.bbox[i, 0] + total[:, 1:2] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
     occ_rows = occ[jnp.clip(rows, 0, r - 1)]  # (P, K, W)
     runs = c.runs[i][None] + total[:, 0, None, None]  # (P, K, 4)
     bits = run_bits(runs[..., 0::2], runs[..., 1::2], cfg)  # (P, K, 2, W)

@@ -20,7 +20,7 @@ from vccjax.instructions import (
     SHAPES,
 )
 from vccjax.program import Program
-from vccjax.scene import Scene, SceneObject, to_units
+from vccjax.scene import Scene, SceneObject, box_inside, to_units
 
 
 @dataclasses.dataclass
@@ -171,21 +171,21 @@ class RefMachine:
 
     def carry(self, path: list[tuple[int, int]]) -> None:
         """Move the held object along pixel offsets path[0]=(0,0), path[1], ...; stop before
-        the first offset where it would overlap another object or leave the raster."""
+        the first offset where it would overlap another object or its w x w box would
+        leave the workspace."""
         i = self.need_held()
-        r = self.cfg.raster
+        o = self.objects[i]
+        s = self.cfg.sub
+        w = to_units(o.width, self.cfg)
         blocked = self.imagined_set()
         for j in self.real_alive():
             if j != i:
                 blocked |= self.pixels(j)
         last = (0, 0)
         for dx, dy in path[1:]:
-            px = self.pixels(i, dx, dy)
-            if any(not (0 <= a < r and 0 <= b < r) for a, b in px) or px & blocked:
+            if not box_inside(o.x + dx * s, o.y + dy * s, w, self.cfg) or self.pixels(i, dx, dy) & blocked:
                 break
             last = (dx, dy)
-        s = self.cfg.sub
-        o = self.objects[i]
         o.x += last[0] * s
         o.y += last[1] * s
         self.hand = (self.hand[0] + last[0] * s, self.hand[1] + last[1] * s)

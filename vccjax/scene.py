@@ -57,8 +57,7 @@ class Scene:
         for i, o in enumerate(self.objects):
             if not 0 < o.width <= cfg.max_width:
                 raise SceneError(f"object {i} ({o.describe()}): width must be in (0, {cfg.max_width}]")
-            h = o.width / 2
-            if o.x - h < 0 or o.x + h > 1 or o.y - h < 0 or o.y + h > 1:
+            if not box_inside(to_units(o.x, cfg), to_units(o.y, cfg), to_units(o.width, cfg), cfg):
                 raise SceneError(f"object {i} ({o.describe()}) lies outside the workspace")
         if self.pointer is not None:
             px, py = self.pointer
@@ -120,6 +119,13 @@ class Scene:
 def to_units(v: float, cfg: VCCConfig) -> int:
     """A coordinate in [0, 1] as integer position units (round half to even)."""
     return int(np.rint(float(v) * cfg.units))
+
+
+def box_inside(x: int, y: int, w: int, cfg: VCCConfig) -> bool:
+    """Whether an object's w x w box (integer units, centre x, y) lies in the workspace.
+    Doubled to stay in integers: 2x - w >= 0 and 2x + w <= 2U."""
+    u2 = 2 * cfg.units
+    return 2 * x - w >= 0 and 2 * x + w <= u2 and 2 * y - w >= 0 and 2 * y + w <= u2
 
 
 def scenes_match(a: Scene, b: Scene, tau: float) -> bool:

@@ -29,6 +29,7 @@ class SceneConst:
     runs: jax.Array  # (N, K, 4) column runs (lo1, hi1, lo2, hi2) per mask row, from row bbox[0]
     cruns: jax.Array  # (N, K, 4) row runs per mask column, from column bbox[2]
     bbox: jax.Array  # (N, 4) mask rows/cols at load: rmin, rmax, cmin, cmax
+    box: jax.Array  # (N, 4) pixel offsets keeping the w x w box in the workspace: x min/max, y min/max
     has_pointer: jax.Array  # () bool
     pointer: jax.Array  # (2,) position units
 
@@ -79,6 +80,7 @@ def load_scene(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG, validate: bool = T
     runs = np.tile(np.array([1, 0, 1, 0], np.int32), (n, k, 1))
     cruns = runs.copy()
     bbox = np.zeros((n, 4), np.int32)
+    box = np.zeros((n, 4), np.int32)
     for i, o in enumerate(scene.objects):
         shape[i] = SHAPES.index(o.shape)
         color[i] = COLORS.index(o.color)
@@ -88,14 +90,25 @@ def load_scene(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG, validate: bool = T
         _, runs[i] = mask_intervals(rows, cols, k)
         _, cruns[i] = mask_intervals(cols, rows, k)
         bbox[i] = rows.min(), rows.max(), cols.min(), cols.max()
+        box[i] = offset_bounds(int(base[i, 0]), int(base[i, 1]), to_units(o.width, cfg), cfg)
     has_ptr = scene.pointer is not None
     ptr = (to_units(scene.pointer[0], cfg), to_units(scene.pointer[1], cfg)) if has_ptr else (0, 0)
     return SceneConst(
         n=jnp.int32(len(scene.objects)), shape=jnp.asarray(shape), color=jnp.asarray(color),
         width=jnp.asarray(width), base=jnp.asarray(base),
-        runs=jnp.asarray(runs), cruns=jnp.asarray(cruns), bbox=jnp.asarray(bbox), has_pointer=jnp.bool_(has_ptr),
+        runs=jnp.asarray(runs), cruns=jnp.asarray(cruns), bbox=jnp.asarray(bbox),
+        box=jnp.asarray(box), has_pointer=jnp.bool_(has_ptr),
         pointer=jnp.asarray(ptr, jnp.int32),
     )
+
+
+def offset_bounds(x: int, y: int, w: int, cfg: VCCConfig) -> tuple[int, int, int, int]:
+    """Whole-pixel offsets (x min, x max, y min, y max) that keep the box inside, exactly
+    the offsets d with scene.box_inside(x + d * sub, ...) true."""
+    s2, u2 = 2 * cfg.sub, 2 * cfg.units
+    lo = lambda v: -((2 * v - w) // s2)  # noqa: E731  ceil((w - 2v) / 2sub)
+    hi = lambda v: (u2 - w - 2 * v) // s2  # noqa: E731
+    return lo(x), hi(x), lo(y), hi(y)
 
 
 def init_state(cfg: VCCConfig = DEFAULT_CONFIG) -> VCCState:
