@@ -56,7 +56,7 @@ def test_every_reference_program_runs_and_changes_a_random_scene():
         CFG, consts, jnp.asarray(np.stack([a[0] for a in arrays])),
         jnp.asarray(np.stack([a[1] for a in arrays]))))
     host_c = jax.device_get(consts)
-    for i, (name, (sc, prog, m)) in enumerate(chosen.items()):
+    for i, (name, (_, _, m)) in enumerate(chosen.items()):
         pick = lambda t: jax.tree.map(lambda x: x[i], t)  # noqa: E731
         assert summary_jax(pick(out), pick(host_c)) == summary_ref(m), name
 

@@ -90,8 +90,8 @@ def cmd_run(a: argparse.Namespace) -> int:
         return 1
     before, after = ascii_scene(scene, cfg), ascii_scene(out, cfg)
     print(f"{'before':<34}after")
-    for l, r in zip(before, after):
-        print(f"{l}  {r}")
+    for left, right in zip(before, after):
+        print(f"{left}  {right}")
     print("before:", *_legend(scene), sep="\n  ")
     print("after:", *_legend(out), sep="\n  ")
     print("changed" if not scenes_match(out, scene, cfg.tau) else "unchanged")

@@ -106,9 +106,6 @@ def op_attend_pointer(cfg, c, s, arg):
     return s.replace(attended=jnp.argmax(under).astype(jnp.int32)), ~c.has_pointer | ~under.any()
 
 
-_FIXATE_TARGETS = ("left", "right", "top", "bottom", "center")
-
-
 def op_fixate(cfg, c, s, arg):
     u, h = cfg.units, cfg.units // 2
     targets = jnp.array([[0, h], [u, h], [h, 0], [h, u], [h, h]], jnp.int32)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -154,8 +153,3 @@ def scenes_match(a: Scene, b: Scene, tau: float) -> bool:
         return False
 
     return all(augment(i, [False] * n) for i in range(n))
-
-
-def same_objects(a: Sequence[SceneObject], b: Sequence[SceneObject]) -> bool:
-    """Exact equality of object lists (order included), for determinism checks."""
-    return tuple(a) == tuple(b)
