@@ -132,12 +132,18 @@ def op_fixate_next(cfg, c, s, arg):
     return s.replace(hist_idx=h, fovea=s.hist[jnp.minimum(h, cfg.hist_max - 1)]), h >= s.hist_len
 
 
-def op_move_hand_to_attended_object(cfg, c, s, arg):
+def _hand_to_attended(cfg, c, s, arg, carry: bool = True):
     target = _attended_centre(cfg, c, s)
     holding = s.held >= 0
+    fail = (s.attended < 0) | (holding & (s.attended == s.held))
+    if not carry:  # nobody in the batch holds anything: skip the carry's cost
+        return s.replace(hand=target), fail
     carried = motion.carry_toward(c, s, cfg, target)
-    moved = jax.tree.map(lambda a, b: jnp.where(holding, a, b), carried, s.replace(hand=target))
-    return moved, (s.attended < 0) | (holding & (s.attended == s.held))
+    return _select(holding, carried, s.replace(hand=target)), fail
+
+
+def op_move_hand_to_attended_object(cfg, c, s, arg):
+    return _hand_to_attended(cfg, c, s, arg)
 
 
 def op_grab_object(cfg, c, s, arg):
@@ -243,9 +249,10 @@ def _commit(old: VCCState, new: VCCState, fail, pc) -> VCCState:
     return out.replace(failed=out.failed | fail, fail_index=jnp.where(fail, pc, out.fail_index))
 
 
-def _execute(cfg: VCCConfig, op: int, c: SceneConst, s: VCCState, arg, pc) -> VCCState:
-    """One instruction's semantics (static op), without loop bookkeeping."""
-    new, fail = OPS[op](cfg, c, s, jnp.asarray(arg, jnp.int32))
+def _execute(cfg: VCCConfig, op: int, c: SceneConst, s: VCCState, arg, pc, fn=None) -> VCCState:
+    """One instruction's semantics (static op), without loop bookkeeping; `fn` may stand
+    in for the op's function (a cheaper variant valid for the batch at hand)."""
+    new, fail = (fn or OPS[op])(cfg, c, s, jnp.asarray(arg, jnp.int32))
     if op != OP["scene_parse"]:
         fail = fail | ~s.parsed
     return _commit(s, new, fail, pc)
@@ -303,16 +310,25 @@ def step(cfg: VCCConfig, c: SceneConst, s: VCCState, op, arg) -> VCCState:
                  lambda c_, s_, a_, pc_: _execute_switch(cfg, c_, s_, op, a_, pc_, _TOP_BRANCHES))
 
 
-def step_op(cfg: VCCConfig, op: int, c: SceneConst, s: VCCState, arg) -> VCCState:
+def step_op(cfg: VCCConfig, op: int, c: SceneConst, s: VCCState, arg, fn=None) -> VCCState:
     """One program instruction with a static op: only that op's code is traced."""
     return _step(cfg, c, s, op, arg,
-                 lambda c_, s_, a_, pc_: _execute(cfg, op, c_, s_, a_, pc_))
+                 lambda c_, s_, a_, pc_: _execute(cfg, op, c_, s_, a_, pc_, fn))
 
 
 @functools.partial(jax.jit, static_argnums=(0, 1))
 def step_batch(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, args: jax.Array) -> VCCState:
     """Step a batch of states (each with its own scene) by the same instruction."""
-    return jax.vmap(functools.partial(step_op, cfg, op))(consts, states, args)
+    full = jax.vmap(functools.partial(step_op, cfg, op))
+    if op != OP["move_hand_to_attended_object"]:
+        return full(consts, states, args)
+    # approaching an object (empty hand) is cheap, carrying one is not: pay for the carry
+    # only when some state in the batch holds an object
+    approach = functools.partial(_hand_to_attended, carry=False)
+    return jax.lax.cond(
+        jnp.any(states.held >= 0), full,
+        jax.vmap(functools.partial(step_op, cfg, op, fn=approach)), consts, states, args,
+    )
 
 
 def _run(cfg, c, ops, args):
