@@ -107,6 +107,33 @@ def cmd_concepts(a: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_dataset_build(a: argparse.Namespace) -> int:
+    import os
+    import time
+
+    from vccjax.dataset import build_dataset
+
+    concepts = None if a.concepts in (None, "all") else [c.strip() for c in a.concepts.split(",") if c.strip()]
+    start = time.time()
+    m = build_dataset(a.out, concepts, seed=a.seed, workers=a.workers or os.cpu_count() or 1)
+    print(f"{len(m['concepts'])} concepts written to {a.out} (seed {a.seed}) in {time.time() - start:.0f}s")
+    for name, why in m["failed"].items():
+        print(f"not built: {name}: {why}")
+    return 1 if m["failed"] else 0
+
+
+def cmd_dataset_info(a: argparse.Namespace) -> int:
+    from vccjax.dataset import Dataset
+
+    ds = Dataset(a.folder)
+    for name in ds.concepts:  # verifies every file's hashes
+        ds.arrays(name)
+    m = ds.manifest
+    print(f"{a.folder}: {m['format']} v{m['version']}, seed {m['seed']}, {len(ds.concepts)} concepts verified, "
+          f"{len(m['failed'])} not built")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="vcc",
@@ -124,6 +151,17 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--engine", choices=["jax", "reference"], default="jax",
                    help="the JAX emulator (default) or the scalar reference interpreter")
     r.set_defaults(fn=cmd_run)
+    d = sub.add_parser("dataset", help="build or check the concepts' example pairs")
+    dsub = d.add_subparsers(dest="action", required=True, metavar="ACTION")
+    b = dsub.add_parser("build", help="generate 10 training and 50 test pairs per concept (resumable)")
+    b.add_argument("--concepts", default="all", help="'all' (default) or a comma-separated list")
+    b.add_argument("--seed", type=int, default=0, help="seed (default 0); same seed, same bytes")
+    b.add_argument("--out", default="data/examples", help="output folder (default data/examples)")
+    b.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")
+    b.set_defaults(fn=cmd_dataset_build)
+    i = dsub.add_parser("info", help="verify a built dataset and summarise it")
+    i.add_argument("folder")
+    i.set_defaults(fn=cmd_dataset_info)
     c = sub.add_parser("concepts", help="list the 546 concepts with their program lengths")
     c.add_argument("pattern", nargs="?", help="only names containing this")
     c.set_defaults(fn=cmd_concepts)

@@ -1,0 +1,114 @@
+"""The concept dataset: complete, deterministic to the byte, verified on load, resumable."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from vccjax.concepts import concept_names, reference_program
+from vccjax.config import DEFAULT_CONFIG as CFG
+from vccjax.dataset import Dataset, build_dataset, read_npz, write_npz
+from vccjax.errors import DataFileError
+from vccjax.examples import TEST, TRAIN, uses_pointer
+from vccjax.reference import RefMachine
+from vccjax.scene import scenes_match
+
+SOME = ["swap_locations", "form_circle_shape_using_same_objs", "chained_movement_left_most_object",
+        "move_<COLOR>_objects_to_touch_imagined_horizontal_line_at_top_pointer"]
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ds")
+    build_dataset(out, SOME, seed=3, progress=False)
+    return out
+
+
+def test_all_546_concepts_get_10_train_and_50_test_pairs(tmp_path):
+    manifest = build_dataset(tmp_path, seed=0, workers=2, progress=False)
+    assert manifest["failed"] == {}, manifest["failed"]  # no concept may be left out
+    ds = Dataset(tmp_path)
+    assert sorted(ds.concepts) == sorted(concept_names())
+    for name in ds.concepts:
+        train, test = ds.pairs(name, "train"), ds.pairs(name, "test")
+        assert len(train) == TRAIN.count and len(test) == TEST.count, name
+        assert all((p[0].pointer is not None) == uses_pointer(reference_program(name)) for p in train)
+
+
+def test_pairs_are_what_the_program_does(small):
+    ds = Dataset(small)
+    for name in SOME:
+        program = reference_program(name)
+        for split, spec in (("train", TRAIN), ("test", TEST)):
+            for inp, out in ds.pairs(name, split):
+                assert spec.objects[0] <= len(inp.objects) <= spec.objects[1]
+                assert all(spec.widths[0] <= o.width <= spec.widths[1] for o in inp.objects)
+                m = RefMachine(inp).run(program)
+                assert not m.failed and m.output_scene() == out  # the stored output, exactly
+                assert not scenes_match(inp, out, CFG.tau)  # the concept changed the scene
+                out.validate()
+
+
+def test_same_seed_same_bytes(small, tmp_path):
+    build_dataset(tmp_path, SOME, seed=3, progress=False)
+    for f in sorted(p.name for p in small.iterdir()):
+        assert (small / f).read_bytes() == (tmp_path / f).read_bytes(), f
+    other = tmp_path / "other"
+    m = build_dataset(other, SOME[:1], seed=4, progress=False)
+    first = json.loads((small / "manifest.json").read_text())["concepts"][SOME[0]]["sha256"]
+    assert m["concepts"][SOME[0]]["sha256"] != first  # another seed, other examples
+
+
+def test_resume_keeps_good_files_and_rebuilds_bad_ones(small, tmp_path):
+    build_dataset(tmp_path, SOME, seed=3, progress=False)
+    files = sorted(tmp_path.glob("c*.npz"))
+    files[0].unlink()
+    files[1].write_bytes(b"garbage")
+    kept = files[2].stat().st_mtime_ns
+    build_dataset(tmp_path, SOME, seed=3, progress=False)
+    assert files[2].stat().st_mtime_ns == kept  # intact work is not redone
+    for f in files:
+        assert f.read_bytes() == (small / f.name).read_bytes()
+
+
+def test_corrupt_and_foreign_files_are_refused(small, tmp_path):
+    import shutil
+
+    bad = tmp_path / "bad"
+    shutil.copytree(small, bad)
+    ds_file = sorted(bad.glob("c*.npz"))[0]
+    data = bytearray(ds_file.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    ds_file.write_bytes(bytes(data))
+    ds = Dataset(bad)
+    name = next(n for n, e in ds.manifest["concepts"].items() if e["file"] == ds_file.name)
+    with pytest.raises(DataFileError, match=f"{ds_file.name}: sha256 differs"):
+        ds.pairs(name)
+    # a file rewritten with edited arrays but an old content hash
+    arrays = read_npz(small / ds_file.name)
+    arrays["train_in"] = arrays["train_in"] + 0.01
+    write_npz(tmp_path / "edited.npz", arrays)
+    raw = dict(np.load(tmp_path / "edited.npz"))
+    raw["content_hash"] = np.frombuffer(b"0" * 64, np.uint8)
+    np.savez(tmp_path / "forged.npz", **raw)
+    with pytest.raises(DataFileError, match="content hash mismatch"):
+        read_npz(tmp_path / "forged.npz")
+    np.savez(tmp_path / "plain.npz", a=np.zeros(3))
+    with pytest.raises(DataFileError, match="no content hash"):
+        read_npz(tmp_path / "plain.npz")
+    (tmp_path / "text.npz").write_text("hello")
+    with pytest.raises(DataFileError, match="not a readable NPZ"):
+        read_npz(tmp_path / "text.npz")
+    manifest = json.loads((small / "manifest.json").read_text())
+    for edit, msg in (({"version": 99}, "format version 99"), ({"format": "other"}, "not a vccjax-dataset")):
+        folder = tmp_path / f"m{len(msg)}"
+        folder.mkdir()
+        (folder / "manifest.json").write_text(json.dumps({**manifest, **edit}))
+        with pytest.raises(DataFileError, match=msg):
+            Dataset(folder)
+    with pytest.raises(DataFileError, match="missing"):
+        Dataset(tmp_path / "nowhere")
+    with pytest.raises(DataFileError, match="not in this dataset"):
+        Dataset(small).pairs("remove_top_obj")

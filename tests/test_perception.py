@@ -1,0 +1,55 @@
+"""Rendering and OpenCV perception: round trips on clear scenes, and clear errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import obj, scene
+
+from vccjax.config import DEFAULT_CONFIG as CFG
+from vccjax.errors import SceneError
+from vccjax.perception import parse_image
+from vccjax.render import render
+from vccjax.scene import scenes_match
+
+CLEAR = scene(obj("square", "red", 0.2, 0.2, 0.12), obj("circle", "green", 0.7, 0.25, 0.12),
+              obj("diamond", "blue", 0.3, 0.7, 0.14), obj("triangle", "yellow", 0.75, 0.75, 0.12),
+              obj("star", "red", 0.5, 0.45, 0.15), pointer=(0.1, 0.9))
+
+
+@pytest.mark.parametrize("style", ["schematic", "varied"])
+def test_render_is_seeded_rgb(style):
+    a, b = render(CLEAR, 256, style, seed=4), render(CLEAR, 256, style, seed=4)
+    assert a.shape == (256, 256, 3) and a.dtype == np.uint8 and (a == b).all()
+    if style == "varied":
+        assert (render(CLEAR, 256, style, seed=5) != a).any()
+
+
+@pytest.mark.parametrize("style", ["schematic", "varied"])
+def test_parse_recovers_every_shape_color_and_the_pointer(style):
+    for seed in range(3):
+        parsed = parse_image(render(CLEAR, 256, style, seed=seed))
+        assert scenes_match(parsed, CLEAR, CFG.tau), parsed
+        assert abs(parsed.pointer[0] - 0.1) < CFG.tau and abs(parsed.pointer[1] - 0.9) < CFG.tau
+        for o in parsed.objects:
+            true = min(CLEAR.objects, key=lambda t: (t.x - o.x) ** 2 + (t.y - o.y) ** 2)
+            assert abs(o.width - true.width) < 0.02
+
+
+def test_image_with_nothing_is_an_error():
+    with pytest.raises(SceneError, match="no objects found"):
+        parse_image(np.full((128, 128, 3), 255, np.uint8))
+    with pytest.raises(SceneError, match="no objects found"):
+        parse_image(render(scene(pointer=(0.5, 0.5)), 128))
+
+
+def test_unknown_color_is_an_error():
+    img = render(CLEAR, 256)
+    img[100:130, 100:130] = (160, 40, 200)  # purple
+    with pytest.raises(SceneError, match=r"unknown color \(hue"):
+        parse_image(img)
+
+
+def test_not_an_image_is_an_error():
+    with pytest.raises(SceneError, match="expected an RGB uint8 image"):
+        parse_image(np.zeros((64, 64), np.uint8))

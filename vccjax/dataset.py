@@ -1,0 +1,241 @@
+"""The examples of all concepts on disk: versioned, hashed NPZ files and a JSON manifest.
+
+Layout of a dataset folder:
+  manifest.json   format name and version, seed, machine config, per-concept file and
+                  sha256, and the concepts that could not be built with the reason
+  c000.npz ...    one file per concept (concept names hold characters unsafe in file
+                  names): the concept, its program, seed, and the scene arrays.
+
+Files are written byte-for-byte deterministically (fixed zip timestamps), so the same
+seed gives the same bytes. Loading checks the format version, each file's sha256 and
+each file's own content hash, and refuses foreign or corrupt files by name. Nothing is
+unpickled.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import zipfile
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+from vccjax.concepts import concept_names, reference_program
+from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.errors import DataFileError
+from vccjax.examples import TEST, TRAIN, ExampleError, make_pairs
+from vccjax.instructions import COLORS, SHAPES
+from vccjax.scene import Scene, SceneObject
+
+FORMAT = "vccjax-dataset"
+VERSION = 1
+_FIELDS = 6  # alive, shape, color, x, y, width
+
+
+# ---- scenes <-> arrays ----------------------------------------------------------------
+def scenes_to_arrays(scenes: list[Scene], n_max: int) -> tuple[np.ndarray, np.ndarray]:
+    objs = np.zeros((len(scenes), n_max, _FIELDS), np.float64)
+    ptr = np.zeros((len(scenes), 3), np.float64)
+    for i, sc in enumerate(scenes):
+        for j, o in enumerate(sc.objects):
+            objs[i, j] = 1, SHAPES.index(o.shape), COLORS.index(o.color), o.x, o.y, o.width
+        if sc.pointer is not None:
+            ptr[i] = 1, *sc.pointer
+    return objs, ptr
+
+
+def arrays_to_scenes(objs: np.ndarray, ptr: np.ndarray) -> list[Scene]:
+    out = []
+    for row, p in zip(objs, ptr):
+        items = tuple(
+            SceneObject(SHAPES[int(o[1])], COLORS[int(o[2])], float(o[3]), float(o[4]), float(o[5]))
+            for o in row if o[0] == 1
+        )
+        out.append(Scene(items, (float(p[1]), float(p[2])) if p[0] == 1 else None))
+    return out
+
+
+# ---- deterministic NPZ with a content hash ----------------------------------------------
+def _content_hash(arrays: dict[str, np.ndarray]) -> str:
+    h = hashlib.sha256()
+    for key in sorted(arrays):
+        a = np.ascontiguousarray(arrays[key])
+        h.update(key.encode() + b"\0" + a.dtype.str.encode() + str(a.shape).encode() + a.tobytes())
+    return h.hexdigest()
+
+
+def _text(s: str) -> np.ndarray:
+    return np.frombuffer(s.encode(), np.uint8).copy()
+
+
+def write_npz(path: Path, arrays: dict[str, np.ndarray]) -> str:
+    """Write arrays plus `content_hash`; same arrays, same bytes. Returns the file's sha256."""
+    arrays = dict(arrays)
+    arrays["content_hash"] = _text(_content_hash(arrays))
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        for key in sorted(arrays):
+            info = zipfile.ZipInfo(key + ".npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            member = io.BytesIO()
+            np.lib.format.write_array(member, np.ascontiguousarray(arrays[key]), allow_pickle=False)
+            z.writestr(info, member.getvalue())
+    data = buf.getvalue()
+    tmp = path.with_suffix(".tmp")
+    tmp.write_bytes(data)
+    tmp.replace(path)  # atomic: an interrupted build never leaves half a file
+    return hashlib.sha256(data).hexdigest()
+
+
+def read_npz(path: Path) -> dict[str, np.ndarray]:
+    """Read a file written by write_npz, checking its content hash."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    except FileNotFoundError:
+        raise DataFileError(f"{path}: missing") from None
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as e:
+        raise DataFileError(f"{path}: not a readable NPZ file ({e})") from None
+    stored = arrays.pop("content_hash", None)
+    if stored is None:
+        raise DataFileError(f"{path}: no content hash (not a vccjax file)")
+    if bytes(stored).decode(errors="replace") != _content_hash(arrays):
+        raise DataFileError(f"{path}: content hash mismatch (corrupt or edited)")
+    return arrays
+
+
+# ---- building ----------------------------------------------------------------------------
+def _concept_rng(seed: int, index: int, split: int) -> np.random.Generator:
+    return np.random.default_rng([seed, index, split])
+
+
+def build_concept(name: str, index: int, seed: int, cfg: VCCConfig) -> dict[str, np.ndarray]:
+    program = reference_program(name)
+    arrays: dict[str, np.ndarray] = {
+        "format_version": np.array([VERSION], np.int32),
+        "concept": _text(name), "program": _text(program.text()),
+        "seed": np.array([seed], np.int64), "raster": np.array([cfg.raster], np.int32),
+    }
+    for split_id, (split, spec) in enumerate((("train", TRAIN), ("test", TEST))):
+        pairs = make_pairs(program, spec, _concept_rng(seed, index, split_id), cfg)
+        for side, scenes in (("in", [p[0] for p in pairs]), ("out", [p[1] for p in pairs])):
+            objs, ptr = scenes_to_arrays(scenes, cfg.n_max)
+            arrays[f"{split}_{side}"] = objs
+            arrays[f"{split}_{side}_pointer"] = ptr
+    return arrays
+
+
+def _build_one(job: tuple[str, int, int, VCCConfig, str]) -> tuple[str, str, str | None]:
+    name, index, seed, cfg, out = job
+    path = Path(out) / f"c{index:03d}.npz"
+    if path.exists():  # resume: keep a finished file if it is intact and from this seed
+        try:
+            a = read_npz(path)
+            if int(a["seed"][0]) == seed and bytes(a["concept"]).decode() == name:
+                return name, hashlib.sha256(path.read_bytes()).hexdigest(), None
+        except DataFileError:
+            pass
+    try:
+        arrays = build_concept(name, index, seed, cfg)
+    except ExampleError as e:
+        return name, "", str(e)
+    return name, write_npz(path, arrays), None
+
+
+def build_dataset(
+    out: str | Path, concepts: Iterable[str] | None = None, seed: int = 0,
+    cfg: VCCConfig = DEFAULT_CONFIG, workers: int = 0, progress: bool = True,
+) -> dict:
+    """Build (or resume building) the dataset under `out`; returns the manifest."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from tqdm import tqdm
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    names = concept_names()
+    wanted = names if concepts is None else list(concepts)
+    unknown = [c for c in wanted if c not in names]
+    if unknown:
+        raise DataFileError(f"unknown concept(s): {', '.join(unknown[:5])}")
+    jobs = [(n, names.index(n), seed, cfg, str(out)) for n in wanted]
+    results = []
+    bar = tqdm(total=len(jobs), desc="concepts", unit="concept", disable=not progress)
+    if workers > 1:  # spawn, not fork: the parent may have started JAX's threads
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+            for r in pool.map(_build_one, jobs, chunksize=4):
+                results.append(r)
+                bar.update()
+    else:
+        for job in jobs:
+            results.append(_build_one(job))
+            bar.update()
+    bar.close()
+    manifest = {
+        "format": FORMAT, "version": VERSION, "seed": seed,
+        "config": {"raster": cfg.raster, "n_max": cfg.n_max},
+        "splits": {"train": vars_of(TRAIN), "test": vars_of(TEST)},
+        "concepts": {n: {"file": f"c{names.index(n):03d}.npz", "sha256": h} for n, h, err in results if not err},
+        "failed": {n: err for n, _, err in results if err},
+    }
+    (out / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True))
+    return manifest
+
+
+def vars_of(spec) -> dict:
+    return {"count": spec.count, "objects": list(spec.objects), "widths": list(spec.widths)}
+
+
+# ---- loading -------------------------------------------------------------------------------
+class Dataset:
+    """A built dataset, verified on open; `pairs(concept, split)` gives Scene pairs."""
+
+    def __init__(self, folder: str | Path):
+        self.folder = Path(folder)
+        path = self.folder / "manifest.json"
+        try:
+            manifest = json.loads(path.read_text())
+        except FileNotFoundError:
+            raise DataFileError(f"{path}: missing (build with `vcc dataset build`)") from None
+        except (json.JSONDecodeError, UnicodeDecodeError) as e:
+            raise DataFileError(f"{path}: not JSON ({e})") from None
+        if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
+            raise DataFileError(f"{path}: not a {FORMAT} manifest")
+        if manifest.get("version") != VERSION:
+            raise DataFileError(f"{path}: format version {manifest.get('version')}, this vccjax reads {VERSION}")
+        self.manifest = manifest
+        self._cache: dict[str, dict[str, np.ndarray]] = {}
+
+    @property
+    def concepts(self) -> list[str]:
+        return list(self.manifest["concepts"])
+
+    def arrays(self, concept: str) -> dict[str, np.ndarray]:
+        if concept not in self._cache:
+            entry = self.manifest["concepts"].get(concept)
+            if entry is None:
+                raise DataFileError(f"{self.folder}: concept {concept!r} is not in this dataset")
+            path = self.folder / entry["file"]
+            if not path.exists():
+                raise DataFileError(f"{path}: missing")
+            if hashlib.sha256(path.read_bytes()).hexdigest() != entry["sha256"]:
+                raise DataFileError(f"{path}: sha256 differs from the manifest (corrupt or replaced)")
+            arrays = read_npz(path)
+            if int(arrays["format_version"][0]) != VERSION:
+                raise DataFileError(f"{path}: format version {int(arrays['format_version'][0])}")
+            if bytes(arrays["concept"]).decode() != concept:
+                raise DataFileError(f"{path}: holds concept {bytes(arrays['concept']).decode()!r}, not {concept!r}")
+            self._cache[concept] = arrays
+        return self._cache[concept]
+
+    def pairs(self, concept: str, split: str = "train") -> list[tuple[Scene, Scene]]:
+        if split not in ("train", "test"):
+            raise ValueError(f"split must be 'train' or 'test', got {split!r}")
+        a = self.arrays(concept)
+        ins = arrays_to_scenes(a[f"{split}_in"], a[f"{split}_in_pointer"])
+        outs = arrays_to_scenes(a[f"{split}_out"], a[f"{split}_out_pointer"])
+        return list(zip(ins, outs))
