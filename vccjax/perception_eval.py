@@ -30,7 +30,7 @@ def _match(true, found, tau):
     return hits, used.count(False)
 
 
-def evaluate(n: int, style: str, seed: int = 0, size: int = 256, progress: bool = True) -> dict:
+def evaluate(n: int, style: str, seed: int = 0, size: int = 384, progress: bool = True) -> dict:
     from tqdm import tqdm
 
     tau = DEFAULT_CONFIG.tau

@@ -50,17 +50,19 @@ def shape_polygon(shape: str, x: float, y: float, w: float, px: float) -> np.nda
 
 
 def _draw_shape(canvas: np.ndarray, shape: str, x: float, y: float, w: float, color, size: int,
-                outline=None, thickness: int = 0) -> None:
+                outline=None, thickness: int = 0, origin: tuple[int, int] = (0, 0)) -> None:
+    """Draw on a supersampled canvas whose pixel (0, 0) is pixel `origin` of the full one."""
     px = size * _SS
     shift = 4  # cv2 sub-pixel coordinates (1/16 pixel); pixel i covers [i, i + 1) * 1/px
+    ox, oy = origin
     if shape == "circle":
-        centre = (int(round((x * px - 0.5) * 16)), int(round((y * px - 0.5) * 16)))
+        centre = (int(round((x * px - 0.5 - ox) * 16)), int(round((y * px - 0.5 - oy) * 16)))
         radius = int(round(w / 2 * px * 16))
         cv2.circle(canvas, centre, radius, color, -1, cv2.LINE_AA, shift)
         if outline is not None:
             cv2.circle(canvas, centre, radius, outline, thickness * _SS, cv2.LINE_AA, shift)
         return
-    poly = np.round((shape_polygon(shape, x, y, w, px) - 0.5) * 16).astype(np.int32)
+    poly = np.round((shape_polygon(shape, x, y, w, px) - 0.5 - (ox, oy)) * 16).astype(np.int32)
     cv2.fillPoly(canvas, [poly], color, cv2.LINE_AA, shift)
     if outline is not None:
         cv2.polylines(canvas, [poly], True, outline, thickness * _SS, cv2.LINE_AA, shift)
@@ -74,7 +76,7 @@ def _draw_pointer(canvas: np.ndarray, p: tuple[float, float], size: int) -> None
     cv2.circle(canvas, c, r // 2, (255, 255, 255), -1, cv2.LINE_AA, 4)
 
 
-def render(scene: Scene, size: int = 256, style: str = "schematic", seed: int = 0) -> np.ndarray:
+def render(scene: Scene, size: int = 384, style: str = "schematic", seed: int = 0) -> np.ndarray:
     """An (size, size, 3) uint8 RGB image of the scene."""
     if style not in STYLES:
         raise ValueError(f"unknown style {style!r}; expected one of {STYLES}")
@@ -115,21 +117,28 @@ def _render_varied(scene: Scene, size: int, rng: np.random.Generator) -> np.ndar
         base = np.array(PALETTE[o.color], np.float64)
         # colour jitter within the class: brightness and a little channel noise
         col = np.clip(base * rng.uniform(0.8, 1.1) + rng.normal(0, 8, 3), 0, 255)
-        layer = np.zeros((big, big, 3), np.uint8)
-        mask = np.zeros((big, big), np.uint8)
-        _draw_shape(layer, o.shape, o.x, o.y, o.width, tuple(float(v) for v in col), size)
-        _draw_shape(mask, o.shape, o.x, o.y, o.width, 255, size)
-        # shading: darker away from a light direction, within the object
-        yy, xx = np.mgrid[0:big, 0:big] / big
         ang = rng.uniform(0, 2 * math.pi)
+        outlined = rng.random() < 0.5
+        # work in the object's window only
+        r = int(math.ceil((o.width / 2) * big)) + 3 * _SS
+        x0, y0 = max(int(o.x * big) - r, 0), max(int(o.y * big) - r, 0)
+        x1, y1 = min(int(o.x * big) + r, big), min(int(o.y * big) + r, big)
+        shape = (y1 - y0, x1 - x0)
+        layer = np.zeros(shape + (3,), np.uint8)
+        mask = np.zeros(shape, np.uint8)
+        _draw_shape(layer, o.shape, o.x, o.y, o.width, tuple(float(v) for v in col), size, origin=(x0, y0))
+        _draw_shape(mask, o.shape, o.x, o.y, o.width, 255, size, origin=(x0, y0))
+        # shading: darker away from a light direction, within the object
+        yy, xx = (np.mgrid[y0:y1, x0:x1] + 0.5) / big
         shade = 1 + 0.15 * ((xx - o.x) * math.cos(ang) + (yy - o.y) * math.sin(ang)) / max(o.width, 1e-3)
         a = (mask / 255.0)[..., None]
-        img = img * (1 - a) + layer.astype(np.float64) * shade[..., None] * a
-        if rng.random() < 0.5:  # a dark outline
-            edge = np.zeros((big, big), np.uint8)
-            _draw_shape(edge, o.shape, o.x, o.y, o.width, 0, size, outline=255, thickness=1)
-            e = (edge / 255.0)[..., None]
-            img = img * (1 - 0.6 * e)
+        win = img[y0:y1, x0:x1]
+        win = win * (1 - a) + layer.astype(np.float64) * shade[..., None] * a
+        if outlined:  # a dark outline
+            edge = np.zeros(shape, np.uint8)
+            _draw_shape(edge, o.shape, o.x, o.y, o.width, 0, size, outline=255, thickness=1, origin=(x0, y0))
+            win = win * (1 - 0.6 * (edge / 255.0)[..., None])
+        img[y0:y1, x0:x1] = win
     if scene.pointer is not None:
         ptr = np.clip(img, 0, 255).astype(np.uint8)
         _draw_pointer(ptr, scene.pointer, size)
