@@ -25,7 +25,7 @@ import numpy as np
 
 from vccjax.concepts import concept_names, reference_program
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.errors import DataFileError
+from vccjax.errors import DataFileError, read_json
 from vccjax.examples import TEST, TRAIN, ExampleError, make_pairs
 from vccjax.instructions import COLORS, SHAPES
 from vccjax.scene import Scene, SceneObject
@@ -197,12 +197,7 @@ class Dataset:
     def __init__(self, folder: str | Path):
         self.folder = Path(folder)
         path = self.folder / "manifest.json"
-        try:
-            manifest = json.loads(path.read_text())
-        except FileNotFoundError:
-            raise DataFileError(f"{path}: missing (build with `vcc dataset build`)") from None
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
-            raise DataFileError(f"{path}: not JSON ({e})") from None
+        manifest = read_json(path, DataFileError, "missing (build with `vcc dataset build`)")
         if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
             raise DataFileError(f"{path}: not a {FORMAT} manifest")
         if manifest.get("version") != VERSION:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.errors import SceneError
+from vccjax.errors import SceneError, read_json
 from vccjax.geometry import object_pixels
 from vccjax.instructions import COLORS, SHAPES
 
@@ -105,14 +105,8 @@ class Scene:
 
     @classmethod
     def load(cls, path: str | Path) -> Scene:
-        p = Path(path)
-        try:
-            d = json.loads(p.read_text())
-        except FileNotFoundError:
-            raise SceneError(f"{p}: no such scene file") from None
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
-            raise SceneError(f"{p}: not a JSON scene file ({e})") from None
-        return cls.from_dict(d, where=str(p))
+        d = read_json(path, SceneError, "no such scene file", what="a JSON scene file")
+        return cls.from_dict(d, where=str(path))
 
 
 def to_units(v: float, cfg: VCCConfig) -> int:
