@@ -10,7 +10,8 @@ import numpy as np
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import SceneError
 from vccjax.instructions import COLORS, SHAPES
-from vccjax.scene import Scene, SceneObject
+from vccjax.geometry import object_pixels
+from vccjax.scene import Scene, SceneObject, box_inside, to_units
 
 
 def random_scene(
@@ -21,29 +22,54 @@ def random_scene(
     pointer: bool = False,
     cfg: VCCConfig = DEFAULT_CONFIG,
     max_tries: int = 200,
+    gap: int = 2,
+    pointer_clearance: int = 3,
 ) -> Scene:
-    """A valid scene: objects drawn uniformly, placed by rejection so none overlap."""
+    """A valid scene: objects drawn uniformly, placed by rejection.
+
+    Generated inputs keep `gap` raster pixels between objects' masks (so that their
+    drawn shapes never touch, as in the paper's figures, and an image parser can tell
+    them apart), and the pointer `pointer_clearance` pixels away from every object.
+    """
     if isinstance(n_objects, tuple):
         n = int(rng.integers(n_objects[0], n_objects[1] + 1))
     else:
         n = int(n_objects)
     if n > cfg.n_max:
         raise SceneError(f"asked for {n} objects; n_max is {cfg.n_max}")
+    r = cfg.raster
+    covered = np.zeros((r, r), bool)  # objects' masks
+    blocked = np.zeros((r, r), bool)  # masks grown by `gap`
     objs: list[SceneObject] = []
     for _ in range(n):
         for _ in range(max_tries):
             w = float(rng.uniform(*widths))
             x, y = (float(v) for v in rng.uniform(w / 2, 1 - w / 2, size=2))
             cand = SceneObject(str(rng.choice(SHAPES)), str(rng.choice(COLORS)), x, y, w)
-            try:
-                Scene(tuple(objs) + (cand,)).validate(cfg)
-            except SceneError:
+            if not box_inside(to_units(x, cfg), to_units(y, cfg), to_units(w, cfg), cfg):
+                continue
+            rows, cols = object_pixels(cand.shape, w, to_units(x, cfg), to_units(y, cfg), cfg)
+            if blocked[rows, cols].any():
                 continue
             objs.append(cand)
+            covered[rows, cols] = True
+            for dr in range(-gap, gap + 1):
+                for dc in range(-gap, gap + 1):
+                    blocked[np.clip(rows + dr, 0, r - 1), np.clip(cols + dc, 0, r - 1)] = True
             break
         else:
             raise SceneError(f"could not place object {len(objs)} in {max_tries} tries")
-    ptr = tuple(float(v) for v in rng.uniform(0.05, 0.95, size=2)) if pointer else None
+    ptr = None
+    if pointer:
+        c = pointer_clearance
+        for _ in range(max_tries):
+            px, py = (float(v) for v in rng.uniform(0.05, 0.95, size=2))
+            i, j = min(int(py * r), r - 1), min(int(px * r), r - 1)
+            if not covered[max(i - c, 0) : i + c + 1, max(j - c, 0) : j + c + 1].any():
+                ptr = (px, py)
+                break
+        else:
+            raise SceneError(f"could not place the pointer clear of objects in {max_tries} tries")
     return Scene(tuple(objs), ptr)
 
 

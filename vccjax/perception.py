@@ -135,9 +135,11 @@ def _clamp(o: SceneObject) -> SceneObject:
 
 
 def _find_pointer(hsv: np.ndarray, objects: np.ndarray) -> tuple[float, float] | None:
-    """The pointer: a dark, unsaturated ring with a light centre, away from objects."""
+    """The pointer: a dark ring with a light centre, away from objects."""
     size_y, size_x = hsv.shape[:2]
-    dark = ((hsv[..., 2] < 70) & (hsv[..., 1] < 90)).astype(np.uint8)
+    # dark by value alone: near black, sensor noise makes any hue and saturation
+    dark = (hsv[..., 2] < 80).astype(np.uint8)
+    dark = cv2.morphologyEx(dark, cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
     near = cv2.dilate(objects.astype(np.uint8), np.ones((5, 5), np.uint8)) > 0
     dark[near] = 0  # outlines hug objects; the pointer does not
     n, _, stats, cents = cv2.connectedComponentsWithStats(dark, connectivity=8)
