@@ -134,6 +134,20 @@ def cmd_dataset_info(a: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_perception_eval(a: argparse.Namespace) -> int:
+    import json
+
+    from vccjax.perception_eval import end_to_end, evaluate
+
+    for style in a.styles.split(","):
+        if a.dataset:
+            r = end_to_end(a.dataset, style, pairs=a.pairs, size=a.size)
+        else:
+            r = evaluate(a.images, style, seed=a.seed, size=a.size)
+        print(json.dumps(r))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="vcc",
@@ -162,6 +176,20 @@ def build_parser() -> argparse.ArgumentParser:
     i = dsub.add_parser("info", help="verify a built dataset and summarise it")
     i.add_argument("folder")
     i.set_defaults(fn=cmd_dataset_info)
+    pe = sub.add_parser("perception", help="measure the image parser")
+    psub = pe.add_subparsers(dest="action", required=True, metavar="ACTION")
+    ev = psub.add_parser("eval", help="accuracy on rendered random scenes, or end to end on a dataset",
+                         description="Without --dataset: render N seeded random scenes per style, parse "
+                                     "them, report objects recovered (shape, color, centre within tau), "
+                                     "images without phantoms, pointers found. With --dataset: run each "
+                                     "concept's program on parsed test inputs and compare outputs.")
+    ev.add_argument("--styles", default="schematic,varied", help="comma-separated styles")
+    ev.add_argument("--images", type=int, default=5000, help="scenes per style (default 5000)")
+    ev.add_argument("--seed", type=int, default=0)
+    ev.add_argument("--size", type=int, default=384, help="image size in pixels (default 384)")
+    ev.add_argument("--dataset", help="a built dataset folder: run the end-to-end check instead")
+    ev.add_argument("--pairs", type=int, default=50, help="test pairs per concept (end to end)")
+    ev.set_defaults(fn=cmd_perception_eval)
     c = sub.add_parser("concepts", help="list the 546 concepts with their program lengths")
     c.add_argument("pattern", nargs="?", help="only names containing this")
     c.set_defaults(fn=cmd_concepts)

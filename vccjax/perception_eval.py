@@ -66,3 +66,41 @@ def evaluate(n: int, style: str, seed: int = 0, size: int = 384, progress: bool 
         "pointer_recovered": ptr_hits / max(ptr_total, 1), "pointers": ptr_total,
         "top_confusions": sorted(confusions.items(), key=lambda kv: -kv[1])[:8],
     }
+
+
+def end_to_end(
+    folder: str, style: str = "varied", pairs: int = 50, concepts: list[str] | None = None,
+    size: int = 384, progress: bool = True,
+) -> dict:
+    """For each concept's test pairs: render the input, parse it, run the reference program
+    on the parsed scene, and compare with the stored (symbolic) output within tau."""
+    from tqdm import tqdm
+
+    from vccjax.concepts import reference_program
+    from vccjax.dataset import Dataset
+    from vccjax.reference import RefMachine
+    from vccjax.scene import scenes_match
+
+    tau = DEFAULT_CONFIG.tau
+    ds = Dataset(folder)
+    names = concepts or ds.concepts
+    per_concept: dict[str, float] = {}
+    for ci, name in enumerate(tqdm(names, desc=f"end to end ({style})", disable=not progress)):
+        program = reference_program(name)
+        good = 0
+        test = ds.pairs(name, "test")[:pairs]
+        for k, (inp, out) in enumerate(test):
+            img = render(inp, size, style, seed=ci * 1000 + k)
+            try:
+                parsed = parse_image(img)
+                m = RefMachine(parsed).run(program)
+                good += (not m.failed) and scenes_match(m.output_scene(), out, tau)
+            except SceneError:
+                pass
+        per_concept[name] = good / len(test)
+    worst = sorted(per_concept.items(), key=lambda kv: kv[1])[:8]
+    return {
+        "style": style, "concepts": len(per_concept), "pairs_per_concept": pairs,
+        "concepts_at_least_99pct": sum(v >= 0.99 for v in per_concept.values()),
+        "mean_pair_agreement": float(np.mean(list(per_concept.values()))), "worst": worst,
+    }
