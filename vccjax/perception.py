@@ -90,12 +90,12 @@ def parse_image(image: np.ndarray, options: ParseOptions = ParseOptions()) -> Sc
     size_y, size_x = image.shape[:2]
     hsv = cv2.cvtColor(image, cv2.COLOR_RGB2HSV)
     saturated = (hsv[..., 1] >= options.min_saturation) & (hsv[..., 2] >= options.min_value)
-    kernel = np.ones((2, 2), np.uint8)
     objects: list[SceneObject] = []
     claimed = np.zeros(saturated.shape, bool)
     for color, bands in HUE_BANDS.items():
+        # no morphological opening here: OpenCV's erode/dilate with an even kernel shift the
+        # region by a pixel, and tiny specks are dropped by area below anyway
         m = (saturated & _hue_mask(hsv, bands)).astype(np.uint8)
-        m = cv2.morphologyEx(m, cv2.MORPH_OPEN, kernel)
         n, labels, stats, _ = cv2.connectedComponentsWithStats(m, connectivity=8)
         for k in range(1, n):
             x0, y0, w, h, area = stats[k]
