@@ -134,7 +134,7 @@ def cmd_dataset_info(a: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_perception_eval(a: argparse.Namespace) -> int:
+def cmd_perception_evaluate(a: argparse.Namespace) -> int:
     import json
 
     from vccjax.perception_eval import end_to_end, evaluate
@@ -189,7 +189,7 @@ def build_parser() -> argparse.ArgumentParser:
     ev.add_argument("--size", type=int, default=384, help="image size in pixels (default 384)")
     ev.add_argument("--dataset", help="a built dataset folder: run the end-to-end check instead")
     ev.add_argument("--pairs", type=int, default=50, help="test pairs per concept (end to end)")
-    ev.set_defaults(fn=cmd_perception_eval)
+    ev.set_defaults(fn=cmd_perception_evaluate)
     c = sub.add_parser("concepts", help="list the 546 concepts with their program lengths")
     c.add_argument("pattern", nargs="?", help="only names containing this")
     c.set_defaults(fn=cmd_concepts)
