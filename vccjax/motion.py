@@ -46,7 +46,7 @@ def _lines(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int):
 
     axis 0: lines are rows, runs are columns; axis 1: lines are columns, runs are rows.
     """
-    table, start = (c.runs, c.bbox[:, 0]) if axis == 0 else (c.cruns, c.bbox[:, 2])
+    table, start = (c.runs, c.corner[:, 0]) if axis == 0 else (c.cruns, c.corner[:, 1])
     line_off, run_off = (s.offset[:, 1], s.offset[:, 0]) if axis == 0 else (s.offset[:, 0], s.offset[:, 1])
     lines = (start + line_off)[:, None] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
     shifted = table + run_off[:, None, None]
@@ -77,7 +77,7 @@ def contains(c: SceneConst, s: VCCState, cfg: VCCConfig, point: jax.Array) -> ja
     """(N,) whether each alive object's mask holds the pixel of `point` (position units)."""
     col = jnp.minimum(point[0] // cfg.sub, cfg.raster - 1)
     row = jnp.minimum(point[1] // cfg.sub, cfg.raster - 1)
-    k = row - (c.bbox[:, 0] + s.offset[:, 1])
+    k = row - (c.corner[:, 0] + s.offset[:, 1])
     ok = (k >= 0) & (k < cfg.mask_rows) & s.alive
     runs = c.runs[jnp.arange(cfg.n_max), jnp.clip(k, 0, cfg.mask_rows - 1)]
     x = col - s.offset[:, 0]
@@ -124,11 +124,11 @@ def slide(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int, sign: int) -> V
     lines, lo, hi = lines[i], lo[i], hi[i]  # (K,), (K, 2), (K, 2)
     words = occ[jnp.clip(lines, 0, r - 1)][:, None, :]  # (K, 1, W)
     start = jnp.arange(cfg.words, dtype=jnp.int32) * 32
-    if sign > 0:  # first occupied pixel after hi, else the edge at R
+    if sign > 0:  # first occupied pixel after hi (R: none; the box bound below then decides)
         ahead = words & ~low_bits(jnp.clip(hi[..., None] + 1 - start, 0, 32))
         first = jnp.min(jnp.where(ahead != 0, start + _ctz(ahead), r), axis=-1)
         gap = first - hi - 1
-    else:  # last occupied pixel before lo, else the edge at -1
+    else:  # last occupied pixel before lo (-1: none)
         behind = words & low_bits(jnp.clip(lo[..., None] - start, 0, 32))
         last = jnp.max(jnp.where(behind != 0, start + 31 - jax.lax.clz(behind).astype(jnp.int32), -1), axis=-1)
         gap = lo - last - 1
@@ -163,7 +163,7 @@ def carry_toward(c: SceneConst, s: VCCState, cfg: VCCConfig, target: jax.Array) 
     out = (
         (total[:, 0] < box[0]) | (total[:, 0] > box[1]) | (total[:, 1] < box[2]) | (total[:, 1] > box[3])
     )
-    rows = c.bbox[i, 0] + total[:, 1:2] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
+    rows = c.corner[i, 0] + total[:, 1:2] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
     occ_rows = occ[jnp.clip(rows, 0, r - 1)]  # (P, K, W)
     runs = c.runs[i][None] + total[:, 0, None, None]  # (P, K, 4)
     bits = run_bits(runs[..., 0::2], runs[..., 1::2], cfg)  # (P, K, 2, W)

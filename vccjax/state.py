@@ -26,9 +26,9 @@ class SceneConst:
     color: jax.Array  # (N,) initial color index
     width: jax.Array  # (N,) float32 width (unit square)
     base: jax.Array  # (N, 2) centre at load, position units (x, y)
-    runs: jax.Array  # (N, K, 4) column runs (lo1, hi1, lo2, hi2) per mask row, from row bbox[0]
-    cruns: jax.Array  # (N, K, 4) row runs per mask column, from column bbox[2]
-    bbox: jax.Array  # (N, 4) mask rows/cols at load: rmin, rmax, cmin, cmax
+    runs: jax.Array  # (N, K, 4) column runs (lo1, hi1, lo2, hi2) per mask row, from row corner[0]
+    cruns: jax.Array  # (N, K, 4) row runs per mask column, from column corner[1]
+    corner: jax.Array  # (N, 2) the mask's top row and left column at load
     box: jax.Array  # (N, 4) pixel offsets keeping the w x w box in the workspace: x min/max, y min/max
     has_pointer: jax.Array  # () bool
     pointer: jax.Array  # (2,) position units
@@ -79,7 +79,7 @@ def load_scene(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG, validate: bool = T
     base = np.zeros((n, 2), np.int32)
     runs = np.tile(np.array([1, 0, 1, 0], np.int32), (n, k, 1))
     cruns = runs.copy()
-    bbox = np.zeros((n, 4), np.int32)
+    corner = np.zeros((n, 2), np.int32)
     box = np.zeros((n, 4), np.int32)
     for i, o in enumerate(scene.objects):
         shape[i] = SHAPES.index(o.shape)
@@ -89,14 +89,14 @@ def load_scene(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG, validate: bool = T
         rows, cols = object_pixels(o.shape, o.width, int(base[i, 0]), int(base[i, 1]), cfg)
         _, runs[i] = mask_intervals(rows, cols, k)
         _, cruns[i] = mask_intervals(cols, rows, k)
-        bbox[i] = rows.min(), rows.max(), cols.min(), cols.max()
+        corner[i] = rows.min(), cols.min()
         box[i] = offset_bounds(int(base[i, 0]), int(base[i, 1]), to_units(o.width, cfg), cfg)
     has_ptr = scene.pointer is not None
     ptr = (to_units(scene.pointer[0], cfg), to_units(scene.pointer[1], cfg)) if has_ptr else (0, 0)
     return SceneConst(
         n=jnp.int32(len(scene.objects)), shape=jnp.asarray(shape), color=jnp.asarray(color),
         width=jnp.asarray(width), base=jnp.asarray(base),
-        runs=jnp.asarray(runs), cruns=jnp.asarray(cruns), bbox=jnp.asarray(bbox),
+        runs=jnp.asarray(runs), cruns=jnp.asarray(cruns), corner=jnp.asarray(corner),
         box=jnp.asarray(box), has_pointer=jnp.bool_(has_ptr),
         pointer=jnp.asarray(ptr, jnp.int32),
     )
@@ -139,10 +139,6 @@ def stack(trees):
     return jax.tree.map(lambda *xs: jnp.stack(xs), *trees)
 
 
-def unstack(tree, i: int):
-    return jax.tree.map(lambda x: x[i], tree)
-
-
 def centres(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
     """(N, 2) current object centres in position units."""
     return c.base + s.offset * cfg.sub
@@ -163,7 +159,7 @@ def output_scene(c: SceneConst, s: VCCState, cfg: VCCConfig, pointer=None) -> Sc
 def object_masks(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
     """(N, R, R) bool masks of the objects on the full raster (dead slots empty)."""
     r = jnp.arange(cfg.raster)
-    k = r[None, :] - (c.bbox[:, 0] + s.offset[:, 1])[:, None]  # (N, R) mask row per raster row
+    k = r[None, :] - (c.corner[:, 0] + s.offset[:, 1])[:, None]  # (N, R) mask row per raster row
     valid = (k >= 0) & (k < cfg.mask_rows) & s.alive[:, None]
     runs = jnp.take_along_axis(c.runs, jnp.clip(k, 0, cfg.mask_rows - 1)[:, :, None], axis=1)
     runs = runs + s.offset[:, None, None, 0]
