@@ -11,9 +11,10 @@ from vccjax.concepts import concept_names, reference_program
 from vccjax.config import DEFAULT_CONFIG as CFG
 from vccjax.dataset import Dataset, build_dataset, read_npz, write_npz
 from vccjax.errors import DataFileError
-from vccjax.examples import TEST, TRAIN, uses_pointer
+from vccjax.examples import TEST, TRAIN, Jitter, is_well_posed, uses_pointer
+from vccjax.program import parse
 from vccjax.reference import RefMachine
-from vccjax.scene import scenes_match
+from vccjax.scene import Scene, SceneObject, scenes_match
 
 SOME = ["swap_locations", "form_circle_shape_using_same_objs", "chained_movement_left_most_object",
         "move_<COLOR>_objects_to_touch_imagined_horizontal_line_at_top_pointer"]
@@ -26,15 +27,38 @@ def small(tmp_path_factory):
     return out
 
 
-def test_all_546_concepts_get_10_train_and_50_test_pairs(tmp_path):
-    manifest = build_dataset(tmp_path, seed=0, workers=2, progress=False)
-    assert manifest["failed"] == {}, manifest["failed"]  # no concept may be left out
-    ds = Dataset(tmp_path)
-    assert sorted(ds.concepts) == sorted(concept_names())
+def _assert_complete(folder, names):
+    ds = Dataset(folder)
+    assert sorted(ds.concepts) == sorted(names)
     for name in ds.concepts:
         train, test = ds.pairs(name, "train"), ds.pairs(name, "test")
         assert len(train) == TRAIN.count and len(test) == TEST.count, name
         assert all((p[0].pointer is not None) == uses_pointer(reference_program(name)) for p in train)
+
+
+@pytest.mark.slow  # about 8 minutes on 2 cores; the sample below runs by default
+def test_all_546_concepts_get_10_train_and_50_test_pairs(tmp_path):
+    manifest = build_dataset(tmp_path, seed=0, workers=2, progress=False)
+    assert manifest["failed"] == {}, manifest["failed"]  # no concept may be left out
+    _assert_complete(tmp_path, concept_names())
+
+
+def test_every_13th_concept_gets_10_train_and_50_test_pairs(tmp_path):
+    names = concept_names()[::13]
+    manifest = build_dataset(tmp_path, names, seed=0, workers=2, progress=False)
+    assert manifest["failed"] == {}, manifest["failed"]
+    _assert_complete(tmp_path, names)
+
+
+def test_an_example_that_hinges_on_a_hair_is_not_well_posed():
+    """Which of two objects is leftmost must not be decided by 0.001 of the workspace."""
+    program = parse("scene_parse; fixate(left); top_down_attend; fill_color(red)")
+    for x2, posed in ((0.301, False), (0.5, True)):
+        scene = Scene((SceneObject("square", "blue", 0.3, 0.3, 0.1),
+                       SceneObject("square", "blue", x2, 0.7, 0.1)))
+        m = RefMachine(scene).run(program)
+        assert not m.failed
+        assert is_well_posed(program, scene, m.output_scene(), Jitter(), np.random.default_rng(0)) is posed
 
 
 def test_pairs_are_what_the_program_does(small):
@@ -112,3 +136,21 @@ def test_corrupt_and_foreign_files_are_refused(small, tmp_path):
         Dataset(tmp_path / "nowhere")
     with pytest.raises(DataFileError, match="not in this dataset"):
         Dataset(small).pairs("remove_top_obj")
+
+
+def test_examples_survive_rendering_and_parsing(small):
+    """End to end: the program run on the parsed input image gives the stored output."""
+    from vccjax.perception_eval import end_to_end
+
+    r = end_to_end(str(small), "varied", pairs=20, concepts=SOME, progress=False)
+    assert r["concepts_at_least_99pct"] == len(SOME), r["worst"]
+
+
+def test_image_pairs_render_both_sides(small):
+    ds = Dataset(small)
+    pairs = ds.image_pairs(SOME[0], "train", style="schematic", size=128)
+    assert len(pairs) == TRAIN.count
+    a, b = pairs[0]
+    assert a.shape == b.shape == (128, 128, 3) and a.dtype == np.uint8 and not np.array_equal(a, b)
+    again = ds.image_pairs(SOME[0], "train", style="schematic", size=128)
+    assert all(np.array_equal(x, y) for p, q in zip(pairs, again) for x, y in zip(p, q))

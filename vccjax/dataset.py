@@ -31,7 +31,7 @@ from vccjax.instructions import COLORS, SHAPES
 from vccjax.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
-VERSION = 1
+VERSION = 2  # 2: examples must be well posed (examples.Jitter)
 _FIELDS = 6  # alive, shape, color, x, y, width
 
 
@@ -134,7 +134,8 @@ def _build_one(job: tuple[str, int, int, VCCConfig, str]) -> tuple[str, str, str
     if path.exists():  # resume: keep a finished file if it is intact and from this seed
         try:
             a = read_npz(path)
-            if int(a["seed"][0]) == seed and bytes(a["concept"]).decode() == name:
+            if (int(a["format_version"][0]) == VERSION and int(a["seed"][0]) == seed
+                    and bytes(a["concept"]).decode() == name):
                 return name, hashlib.sha256(path.read_bytes()).hexdigest(), None
         except DataFileError:
             pass
@@ -234,3 +235,17 @@ class Dataset:
         ins = arrays_to_scenes(a[f"{split}_in"], a[f"{split}_in_pointer"])
         outs = arrays_to_scenes(a[f"{split}_out"], a[f"{split}_out_pointer"])
         return list(zip(ins, outs))
+
+    def image_pairs(
+        self, concept: str, split: str = "train", style: str = "schematic", size: int = 384,
+        seed: int = 0,
+    ) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The concept's pairs as RGB images (rendered on demand, seeded per pair: the same
+        arguments give the same pixels; input and output of a pair share a style draw)."""
+        from vccjax.render import render
+
+        out = []
+        for k, (a, b) in enumerate(self.pairs(concept, split)):
+            s = int(np.random.default_rng([seed, k]).integers(2**31))
+            out.append((render(a, size, style, seed=s), render(b, size, style, seed=s)))
+        return out

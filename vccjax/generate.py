@@ -5,6 +5,7 @@ The tabletop-world dataset builds on this with per-concept rules.
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
@@ -53,9 +54,9 @@ def random_scene(
                 continue
             objs.append(cand)
             covered[rows, cols] = True
-            for dr in range(-gap, gap + 1):
-                for dc in range(-gap, gap + 1):
-                    blocked[np.clip(rows + dr, 0, r - 1), np.clip(cols + dc, 0, r - 1)] = True
+            mask = np.zeros((r, r), np.uint8)
+            mask[rows, cols] = 1
+            blocked |= cv2.dilate(mask, np.ones((2 * gap + 1, 2 * gap + 1), np.uint8)) > 0
             break
         else:
             raise SceneError(f"could not place object {len(objs)} in {max_tries} tries")
