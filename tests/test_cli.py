@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from vccjax.cli import main
+from vcc.cli import main
 
 
 def test_run_concept_prints_before_and_after(capsys):

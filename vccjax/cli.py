@@ -149,11 +149,17 @@ def cmd_perception_evaluate(a: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The emulator's commands alone (the full `vcc` adds the other packages': vcc.cli)."""
     p = argparse.ArgumentParser(
         prog="vcc",
         description="Visual Cognitive Computer toolkit: run cognitive programs on tabletop scenes.",
     )
-    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    add_commands(p.add_subparsers(dest="command", required=True, metavar="COMMAND"))
+    return p
+
+
+def add_commands(sub) -> None:
+    """run, dataset, perception, concepts."""
     r = sub.add_parser("run", help="run a program on a scene and print it before and after",
                        description="Run a VCC program (text like 'scene_parse; fixate(left); ...' "
                                    "or a .vcc file) on a scene and print it before and after.")
@@ -193,14 +199,13 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("concepts", help="list the 546 concepts with their program lengths")
     c.add_argument("pattern", nargs="?", help="only names containing this")
     c.set_defaults(fn=cmd_concepts)
-    return p
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None = None) -> int:
+    args = (parser or build_parser()).parse_args(argv)
     try:
         return args.fn(args)
-    except (VCCError, KeyError) as e:
+    except (VCCError, KeyError, ValueError, NotImplementedError) as e:
         msg = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
         print(f"vcc: error: {msg}", file=sys.stderr)
         return 2

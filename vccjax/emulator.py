@@ -331,6 +331,24 @@ def step_batch(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, ar
     )
 
 
+@functools.partial(jax.jit, static_argnums=(0, 1))
+def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, args: jax.Array) -> VCCState:
+    """Step B programs' states on the same E examples by one static op.
+
+    consts: (E, ...) the examples' scenes; states: (B, E, ...); args: (B,). The scenes
+    are shared, not copied per program: this is the layout the search steps in."""
+
+    def per_program(fn):
+        one = functools.partial(step_op, cfg, op, fn=fn)
+        return jax.vmap(jax.vmap(one, in_axes=(0, 0, None)), in_axes=(None, 0, 0))
+
+    if op != OP["move_hand_to_attended_object"]:
+        return per_program(None)(consts, states, args)
+    approach = functools.partial(_hand_to_attended, carry=False)
+    return jax.lax.cond(jnp.any(states.held >= 0), per_program(None), per_program(approach),
+                        consts, states, args)
+
+
 def _run(cfg, c, ops, args):
     return jax.lax.fori_loop(
         0, ops.shape[0], lambda i, s: step(cfg, c, s, ops[i], args[i]), init_state(cfg)

@@ -1,0 +1,88 @@
+"""`vcc induce`: explore-compress over concepts, resumable."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+from pathlib import Path
+
+
+def enable_compile_cache() -> None:
+    """Keep compiled emulator steps across runs (XLA's persistent cache); VCCJAX_CACHE=off
+    turns it off, another value moves it."""
+    where = os.environ.get("VCCJAX_CACHE", str(Path.home() / ".cache" / "vccjax" / "jax"))
+    if where.lower() == "off":
+        return
+    import jax
+
+    jax.config.update("jax_compilation_cache_dir", where)
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+
+
+def _concepts(spec: str) -> list[str]:
+    from vccjax.concepts import concept_names
+
+    names = concept_names()
+    if spec == "all":
+        return names
+    chosen = [c.strip() for c in spec.split(",") if c.strip()]
+    unknown = [c for c in chosen if c not in names]
+    if unknown:
+        raise ValueError(f"unknown concept(s): {', '.join(unknown)} (see `vcc concepts`)")
+    return chosen
+
+
+def cmd_induce(a: argparse.Namespace) -> int:
+    from search.induce import Settings, induce, summary
+    from vccjax.dataset import Dataset, build_dataset
+
+    settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
+                        epsilon=a.epsilon, max_iterations=a.iterations)
+    names = _concepts(a.concepts)
+    enable_compile_cache()
+    folder = Path(a.dataset) if a.dataset else Path(a.out) / "dataset"
+    if not a.dataset:  # examples for just these concepts (resumable, seeded)
+        build_dataset(folder, names, seed=a.seed, progress=not a.quiet)
+    ds = Dataset(folder)
+    missing = [c for c in names if c not in ds.concepts]
+    if missing:
+        raise ValueError(f"{folder}: no examples for {', '.join(missing[:5])}"
+                         + (" ..." if len(missing) > 5 else ""))
+    run = induce(names, ds.pairs, a.out, settings, progress=not a.quiet)
+    s = summary(run, names)
+    (Path(a.out) / "summary.json").write_text(json.dumps(s, indent=1))
+    print(f"{'concepts':<28}{s['concepts']}")
+    print(f"{'induced':<28}{s['found']}")
+    print(f"{'exact on all test pairs':<28}{s['exact_on_all_test_pairs']}")
+    for it, k in s["per_iteration"].items():
+        print(f"{'  new in iteration ' + str(it):<28}{k}")
+    print(f"{'search time (s)':<28}{s['search_seconds']} (+{s['compile_seconds']} compiling)")
+    print(f"{'programs searched':<28}{s['programs_covered']} ({s['programs_run']} run, rest pruned)")
+    print(f"throughput: {s['programs_per_second']} programs/s searched, "
+          f"{s['programs_run_per_second']} programs/s run on all examples")
+    return 0
+
+
+def add_commands(sub) -> None:
+    p = sub.add_parser(
+        "induce", help="induce programs for concepts from their examples (explore-compress)",
+        description="Explore-compress: search each concept's programs in order of description length "
+                    "under the current model, then refit the model (and subroutines) on what was found, "
+                    "and repeat. Results go to OUT/results.jsonl after every concept; rerunning the same "
+                    "command resumes.",
+    )
+    p.add_argument("--concepts", default="all", help="'all' (default) or a comma-separated list")
+    p.add_argument("--out", required=True, help="run folder (created; an existing one is resumed)")
+    p.add_argument("--budget", type=int, default=500_000, help="programs per concept (default 500000)")
+    p.add_argument("--order", type=int, choices=[0, 1], default=1, help="Markov order (default 1)")
+    p.add_argument("--args", default="oracle",
+                   choices=["uniform", "uniform+fixation", "oracle", "predicted", "predicted+fixation"],
+                   help="argument model (default oracle: the values the reference program uses)")
+    p.add_argument("--subroutines", choices=["on", "off"], default="on")
+    p.add_argument("--epsilon", type=float, default=0.1, help="pseudocount (default 0.1)")
+    p.add_argument("--iterations", type=int, default=8, help="explore-compress iterations at most")
+    p.add_argument("--dataset", help="a built dataset folder (default: build OUT/dataset for these concepts)")
+    p.add_argument("--seed", type=int, default=0, help="dataset seed when building (default 0)")
+    p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.set_defaults(fn=cmd_induce)

@@ -1,0 +1,275 @@
+"""Exploration: enumerate every program under a description-length cutoff, batched.
+
+Depth-first over chunks of the frontier (memory stays bounded by depth x chunk): a
+frame holds up to `chunk` live prefixes with their emulator states on all examples;
+its children (prefix + one portion) are made in slices, grouped by instruction, and
+stepped with `step_examples`, so every group runs one instruction's code over
+(programs x examples) at once. A child that fails on any example is dropped with its
+whole subtree (spec section 3). A child that may end is a complete program: it is
+checked against every example's output on device (YES / NO, and ASK settled on the
+host). The search runs to the end of the tree (paper: DFS to completion) but, once a
+program is found, only cheaper ones can replace it, so the cutoff drops to just below
+its cost.
+
+Budget: the M most probable programs, exactly. The cutoff b* is the first cost (in
+bins) at which at least M programs exist; all programs cheaper than b* are checked,
+and programs costing exactly b* until M have been checked.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import time
+from collections.abc import Callable, Sequence
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from search.chain import NOT_STARTED, OUTSIDE, Chain, cutoff_for_budget
+from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.emulator import step_examples
+from vccjax.explain import ASK, YES, Target, load_target, verdict
+from vccjax.instructions import NAMES, OP, arg_domain
+from vccjax.program import Program
+from vccjax.scene import Scene, scenes_match
+from vccjax.state import SceneConst, init_state, load_scene, output_scene, stack
+
+MAX_PORTIONS = 40
+
+
+@dataclasses.dataclass
+class Task:
+    """A concept's training examples, loaded once for the device."""
+
+    pairs: list[tuple[Scene, Scene]]
+    consts: SceneConst  # (E, ...)
+    targets: Target  # (E, ...)
+
+    @classmethod
+    def from_pairs(cls, pairs: Sequence[tuple[Scene, Scene]], cfg: VCCConfig = DEFAULT_CONFIG) -> Task:
+        if not pairs:
+            raise ValueError("a task needs at least one example pair")
+        return cls(list(pairs), stack([load_scene(a, cfg) for a, _ in pairs]),
+                   stack([load_target(b, cfg) for _, b in pairs]))
+
+    @property
+    def n_examples(self) -> int:
+        return len(self.pairs)
+
+
+@dataclasses.dataclass
+class Result:
+    found: bool
+    program: Program | None
+    text: str | None  # compressed form (subroutine calls), as searched
+    dl_nats: float | None
+    dl_bins: int | None
+    rank: int | None  # programs strictly more probable, + 1
+    nodes: int  # portions run (prefixes visited)
+    programs: int  # complete programs checked on all examples
+    seconds: float  # wall time, compile included
+    cutoff_bins: int
+    budget: int
+    compile_seconds: float = 0.0  # of `seconds`, spent compiling new (op, batch size) steps
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1))
+def advance(cfg: VCCConfig, op: int, consts: SceneConst, targets: Target, states, args):
+    """Step (B, E) states by `op`; return them, whether each program failed on any
+    example, and its verdict per example."""
+    new = step_examples(cfg, op, consts, states, args)
+    v = jax.vmap(jax.vmap(functools.partial(verdict, cfg)), in_axes=(None, 0, None))(consts, new, targets)
+    return new, jnp.any(new.failed, axis=1), v
+
+
+def _take(tree, idx: np.ndarray):
+    return jax.tree.map(lambda a: a[idx], tree)
+
+
+def _concat(trees):
+    return jax.tree.map(lambda *xs: np.concatenate(xs), *trees)
+
+
+@dataclasses.dataclass
+class _Frame:
+    states: object  # pytree of numpy (n, E, ...)
+    last: np.ndarray  # (n,) last token (end marker at the root)
+    syn: np.ndarray  # (n,)
+    cost: np.ndarray  # (n,) bins so far (no end)
+    hist: np.ndarray  # (n, MAX_PORTIONS) portion indices, -1 padded
+    depth: int
+    kids: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # parent, portion, cost
+    pos: int = 0
+
+
+class Explorer:
+    """Batched, pruned enumeration over a chain; one instance keeps its compiled steps."""
+
+    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, chunk: int = 1024, slice_size: int = 4096,
+                 buckets: Sequence[int] = (16, 64, 256, 1024, 4096),
+                 loop_end_buckets: Sequence[int] = (64, 1024)):
+        self.cfg = cfg
+        self.chunk = chunk
+        self.slice_size = slice_size
+        self.buckets = tuple(sorted(buckets))
+        # loop_end replays the body with every instruction's code: ~15 s to compile per
+        # size, so it gets fewer sizes than the rest
+        self.loop_end_buckets = tuple(sorted(loop_end_buckets))
+        self._compiled: set[tuple[int, int, int]] = set()
+        self.compile_seconds = 0.0  # first calls of each (op, size): compile time, kept apart
+
+    # ---- device stepping ------------------------------------------------------------
+    def _run_group(self, op: int, task: Task, states, args: np.ndarray):
+        n = len(args)
+        outs = []
+        start = 0
+        buckets = self.loop_end_buckets if op == OP["loop_end"] else self.buckets
+        while start < n:
+            size = next((b for b in buckets if b >= n - start), buckets[-1])
+            take = min(size, n - start)
+            idx = np.arange(start, start + take)
+            pad = np.concatenate([idx, np.full(size - take, idx[0])])
+            s_in = _take(states, pad)
+            first = (op, size, task.n_examples) not in self._compiled
+            t0 = time.perf_counter()
+            new, failed, v = advance(self.cfg, op, task.consts, task.targets, s_in, jnp.asarray(args[pad]))
+            outs.append((jax.tree.map(lambda a: np.asarray(a)[:take], new),
+                         np.asarray(failed)[:take], np.asarray(v)[:take]))
+            if first:
+                self._compiled.add((op, size, task.n_examples))
+                self.compile_seconds += time.perf_counter() - t0
+            start += take
+        return (_concat([o[0] for o in outs]), np.concatenate([o[1] for o in outs]),
+                np.concatenate([o[2] for o in outs]))
+
+    def _apply(self, chain: Chain, task: Task, states, portions: np.ndarray):
+        """Run each child's portion (one or more atoms) from its parent's state."""
+        n = len(portions)
+        failed = np.zeros(n, bool)
+        verdicts = np.zeros((n, task.n_examples), np.int32)
+        lengths = np.array([len(chain.ops[z]) for z in portions])
+        for k in range(int(lengths.max())):
+            ops = np.array([chain.ops[z][k] if lengths[i] > k else -1 for i, z in enumerate(portions)])
+            args = np.array([chain.args[z][k] if lengths[i] > k else 0 for i, z in enumerate(portions)],
+                            np.int32)
+            for op in np.unique(ops[(ops >= 0) & ~failed]):
+                rows = np.nonzero((ops == op) & ~failed)[0]
+                new, f, v = self._run_group(int(op), task, _take(states, rows), args[rows])
+                jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)
+                failed[rows] |= f
+                verdicts[rows] = v
+        return states, failed, verdicts
+
+    def _explains(self, task: Task, states, i: int, v: np.ndarray) -> bool:
+        if np.all(v == YES):
+            return True
+        if not np.all((v == YES) | (v == ASK)):
+            return False
+        for e, (_, out) in enumerate(task.pairs):  # rare: settle the ambiguous ones on the host
+            if v[e] == ASK:
+                c = jax.tree.map(lambda a: a[e], task.consts)
+                s = jax.tree.map(lambda a: a[i, e], states)
+                if not scenes_match(output_scene(c, s, self.cfg), out, self.cfg.tau):
+                    return False
+        return True
+
+    # ---- the search -------------------------------------------------------------------
+    def search(self, chain: Chain, task: Task, budget: int,
+               progress: Callable[[int], None] | None = None) -> Result:
+        t0 = time.perf_counter()
+        c0 = self.compile_seconds
+        b_star, table = cutoff_for_budget(chain, budget)
+        below = int(table[b_star - 1]) if b_star > 0 else 0
+        quota = budget - below  # programs of cost exactly b* still allowed
+        cutoff = b_star
+        e = task.n_examples
+        root = jax.tree.map(lambda a: np.broadcast_to(np.asarray(a), (1, e) + a.shape).copy(),
+                            init_state(self.cfg))
+        frames = [_Frame(root, np.array([chain.end]), np.array([NOT_STARTED]), np.array([0]),
+                         np.full((1, MAX_PORTIONS), -1, np.int32), 0)]
+        nodes = programs = 0
+        best: tuple[int, np.ndarray] | None = None
+        end_bins = chain.trans_bins[:, chain.end]
+        while frames:
+            fr = frames[-1]
+            if fr.kids is None:
+                fr.kids = self._children(chain, fr, cutoff)
+            parent, z, cost = fr.kids
+            keep = np.nonzero(cost[fr.pos :] + chain.min_rest[chain.tok[z[fr.pos :]],
+                                                              chain.next_syn[chain.tok[z[fr.pos :]], fr.syn[parent[fr.pos :]]]]
+                              <= cutoff)[0] + fr.pos
+            if len(keep) == 0:
+                frames.pop()
+                continue
+            sl = keep[: self.slice_size]
+            fr.pos = int(sl[-1]) + 1
+            p, zz, cc = parent[sl], z[sl], cost[sl]
+            states = _take(fr.states, p)
+            states, failed, verd = self._apply(chain, task, states, zz)
+            nodes += len(sl)
+            tok = chain.tok[zz]
+            syn = chain.next_syn[tok, fr.syn[p]]
+            hist = fr.hist[p].copy()
+            if fr.depth < MAX_PORTIONS:
+                hist[:, fr.depth] = zz
+            total = cc + end_bins[tok]
+            complete = ~failed & (syn == OUTSIDE) & (total <= cutoff)
+            for i in np.nonzero(complete)[0]:
+                if total[i] == b_star:
+                    if quota <= 0:
+                        continue
+                    quota -= 1
+                    if quota == 0:
+                        cutoff = min(cutoff, b_star - 1)
+                programs += 1
+                if self._explains(task, states, int(i), verd[i]) and (best is None or total[i] < best[0]):
+                    best = (int(total[i]), hist[i].copy())
+                    cutoff = min(cutoff, int(total[i]) - 1)
+            if progress:
+                progress(len(sl))
+            live = ~failed & (cc + chain.min_rest[tok, np.maximum(syn, 0)] <= cutoff) & (syn >= 0)
+            if fr.depth + 1 < MAX_PORTIONS:
+                for part in np.array_split(np.nonzero(live)[0], max(1, -(-int(live.sum()) // self.chunk))):
+                    if len(part):
+                        frames.append(_Frame(_take(states, part), tok[part], syn[part], cc[part],
+                                             hist[part], fr.depth + 1))
+        seconds = time.perf_counter() - t0
+        comp = self.compile_seconds - c0
+        if best is None:
+            return Result(False, None, None, None, None, None, nodes, programs, seconds, b_star, budget, comp)
+        portions = [int(x) for x in best[1] if x >= 0]
+        return Result(
+            True, self.program(chain, portions), self.text(chain, portions),
+            chain.program_nats(portions), best[0], int(table[best[0] - 1]) + 1 if best[0] > 0 else 1,
+            nodes, programs, seconds, b_star, budget, comp,
+        )
+
+    def _children(self, chain: Chain, fr: _Frame, cutoff: int):
+        n, zs = len(fr.last), np.arange(chain.n_portions)
+        cost = fr.cost[:, None] + chain.trans_bins[fr.last[:, None], chain.tok[None, :]] + chain.argbins[None, :]
+        syn = chain.next_syn[chain.tok[None, :], fr.syn[:, None]]
+        rest = chain.min_rest[chain.tok[None, :], np.maximum(syn, 0)]
+        ok = (syn >= 0) & (cost + rest <= cutoff)
+        parent, z = np.nonzero(ok)
+        c = cost[parent, z]
+        order = np.argsort(c, kind="stable")  # the most probable children first
+        del n, zs
+        return parent[order], z[order], c[order]
+
+    @staticmethod
+    def program(chain: Chain, portions: Sequence[int]) -> Program:
+        ops = tuple(o for z in portions for o in chain.ops[z])
+        args = tuple(a for z in portions for a in chain.args[z])
+        return Program(ops, args)
+
+    @staticmethod
+    def text(chain: Chain, portions: Sequence[int]) -> str:
+        parts = []
+        for z in portions:
+            t = int(chain.tok[z])
+            vals = [arg_domain(NAMES[o])[a] for o, a in zip(chain.ops[z], chain.args[z]) if arg_domain(NAMES[o])]
+            name = chain.vocab.name(t)
+            parts.append(f"{name}({', '.join(vals)})" if vals else name)
+        return "; ".join(parts)

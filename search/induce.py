@@ -1,0 +1,245 @@
+"""Explore-compress over many concepts, persisted after every concept and resumable.
+
+Iteration 0 searches with a uniform model over the atoms (honest brute force).
+After each iteration the model is refitted on every program found so far; with
+subroutines on, they stay off until an iteration finds nothing new (saturation), then
+compression adds them (as the paper). The run stops when an iteration with its full
+model finds nothing new, or after `max_iterations`.
+
+Reference programs are read only to make examples and, for `--args oracle` and the
+teacher's fixation guidance, for their arguments.
+
+Files under `out/`: `run.json` (the settings; a resume must match them),
+`results.jsonl` (one line per concept tried per iteration, written as soon as it is
+known), `model-K.json` (the model searched with in iteration K).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from search.chain import Chain, uniform_args
+from search.compress import compress
+from search.explore import Explorer, Result, Task
+from search.model import MarkovModel, Vocabulary
+from vccjax.concepts import reference_program
+from vccjax.config import DEFAULT_CONFIG
+from vccjax.errors import DataFileError
+from vccjax.instructions import NAMES, OP, arg_domain
+from vccjax.program import Program, parse
+from vccjax.reference import RefMachine
+from vccjax.scene import Scene, scenes_match
+
+ARG_MODES = ("uniform", "oracle", "uniform+fixation", "predicted", "predicted+fixation")
+
+
+@dataclasses.dataclass(frozen=True)
+class Settings:
+    budget: int = 500_000
+    order: int = 1
+    args: str = "oracle"
+    subroutines: bool = True
+    epsilon: float = 0.1
+    max_iterations: int = 8
+    max_subroutines: int = 100
+    delta: float = 0.01  # nats per cost bin
+
+    def __post_init__(self) -> None:
+        if self.args not in ARG_MODES:
+            raise ValueError(f"--args must be one of {', '.join(ARG_MODES)}, got {self.args!r}")
+        if self.order not in (0, 1):
+            raise ValueError(f"--order must be 0 or 1, got {self.order}")
+        if self.budget < 1:
+            raise ValueError("--budget must be positive")
+
+
+def _values_used(program: Program, op: int) -> set[int]:
+    return {a for o, a in zip(program.ops, program.args) if o == op}
+
+
+def argument_logp(settings: Settings, concept: str) -> dict[int, np.ndarray]:
+    """log p(argument | instruction) for one concept under the settings' mode.
+
+    oracle: uniform over the values its reference program uses; an instruction with
+    arguments that the program never uses is left out (what a perfect predictor gives).
+    +fixation: `fixate` takes the teacher's value (the reference program's)."""
+    mode = settings.args
+    if mode.startswith("predicted"):
+        raise NotImplementedError(
+            "--args predicted needs the argument predictor (argpred), which is not built yet; "
+            "use uniform, uniform+fixation or oracle"
+        )
+    ref = reference_program(concept)
+    if mode == "oracle":
+        out = {}
+        for name in NAMES:
+            if dom := arg_domain(name):
+                used = _values_used(ref, OP[name])
+                lp = np.full(len(dom), -np.inf)
+                if used:
+                    lp[sorted(used)] = -math.log(len(used))
+                out[OP[name]] = lp
+        return out
+    out = uniform_args()
+    if mode.endswith("+fixation"):
+        used = _values_used(ref, OP["fixate"])
+        lp = np.full(len(arg_domain("fixate")), -np.inf)
+        if used:
+            lp[sorted(used)] = -math.log(len(used))
+        out[OP["fixate"]] = lp
+    return out
+
+
+def fit_model(programs: Sequence[Program], settings: Settings, with_subroutines: bool):
+    """The (vocabulary, Markov model) compression gives for the programs found so far."""
+    seqs = [list(p.ops) for p in programs]
+    vocab = Vocabulary()
+    if with_subroutines and seqs:
+        seqs, vocab, _ = compress(seqs, vocab, order=settings.order, epsilon=settings.epsilon,
+                                  cap=settings.max_subroutines)
+    if not seqs:
+        return vocab, MarkovModel.uniform(vocab.size, settings.order)
+    data = seqs + [list(b) for b in vocab.bodies]
+    return vocab, MarkovModel.fit(data, vocab.size, settings.order, settings.epsilon)
+
+
+def generalization(program: Program, pairs: Sequence[tuple[Scene, Scene]], tau: float) -> int:
+    """How many pairs the program gets right (spec section 7)."""
+    good = 0
+    for a, b in pairs:
+        m = RefMachine(a).run(program)
+        good += (not m.failed) and scenes_match(m.output_scene(), b, tau)
+    return good
+
+
+class Run:
+    """One induction run on disk."""
+
+    def __init__(self, out: str | Path, settings: Settings):
+        self.out = Path(out)
+        self.settings = settings
+        self.out.mkdir(parents=True, exist_ok=True)
+        meta = self.out / "run.json"
+        mine = dataclasses.asdict(settings)
+        if meta.exists():
+            try:
+                theirs = json.loads(meta.read_text())
+            except json.JSONDecodeError as e:
+                raise DataFileError(f"{meta}: not JSON ({e})") from None
+            if theirs.get("settings") != mine:
+                raise DataFileError(
+                    f"{meta}: this folder holds a run with other settings {theirs.get('settings')}; "
+                    "use another --out or the same settings to resume"
+                )
+        else:
+            meta.write_text(json.dumps({"format": "vccjax-induce", "version": 1, "settings": mine}, indent=1))
+        self.results_path = self.out / "results.jsonl"
+        self.records: list[dict] = []
+        if self.results_path.exists():
+            lines = self.results_path.read_text().splitlines()
+            for i, line in enumerate(lines):
+                try:
+                    self.records.append(json.loads(line))
+                except json.JSONDecodeError:
+                    if i == len(lines) - 1:  # a line cut by an interrupt: drop it, redo that concept
+                        break
+                    raise DataFileError(f"{self.results_path}: line {i + 1} is not JSON") from None
+            self.results_path.write_text("".join(json.dumps(r) + "\n" for r in self.records))
+
+    def found(self) -> dict[str, dict]:
+        return {r["concept"]: r for r in self.records if r["found"]}
+
+    def tried(self, iteration: int) -> set[str]:
+        return {r["concept"] for r in self.records if r["iteration"] == iteration}
+
+    def append(self, record: dict) -> None:
+        self.records.append(record)
+        with self.results_path.open("a") as f:
+            f.write(json.dumps(record) + "\n")
+            f.flush()
+
+
+def _record(concept: str, it: int, r: Result, test: tuple[int, int] | None) -> dict:
+    return {
+        "concept": concept, "found": r.found, "iteration": it,
+        "program": r.program.text() if r.program else None, "compressed": r.text,
+        "dl": r.dl_nats, "rank": r.rank, "nodes": r.nodes, "programs_run": r.programs,
+        "covered": r.rank if r.found else r.budget, "seconds": round(r.seconds, 3),
+        "compile_seconds": round(r.compile_seconds, 3),
+        "test_correct": test[0] if test else None, "test_total": test[1] if test else None,
+    }
+
+
+def induce(
+    concepts: Sequence[str], pairs: Callable[[str, str], list[tuple[Scene, Scene]]],
+    out: str | Path, settings: Settings, explorer: Explorer | None = None,
+    progress: bool = True, log: Callable[[str], None] = print,
+) -> Run:
+    """Explore-compress over `concepts`; `pairs(concept, split)` gives examples."""
+    from tqdm import tqdm
+
+    run = Run(out, settings)
+    explorer = explorer or Explorer()
+    subs_on = False
+    for it in range(settings.max_iterations):
+        before = {r["concept"]: r for r in run.records if r["found"] and r["iteration"] < it}
+        programs = [parse(before[c]["program"]) for c in sorted(before)]
+        if it == 0:
+            vocab, model = Vocabulary(), MarkovModel.uniform(Vocabulary().size, settings.order)
+        else:
+            vocab, model = fit_model(programs, settings, subs_on)
+        (run.out / f"model-{it}.json").write_text(json.dumps({
+            "iteration": it, "order": settings.order, "subroutines": vocab.to_json(),
+            "tokens": [vocab.name(t) for t in range(vocab.size)] + ["<end>"],
+            "logp": np.round(model.logp, 6).tolist(),
+        }))
+        done = {r["concept"] for r in run.records if r["iteration"] == it} | set(before)
+        todo = [c for c in concepts if c not in done]
+        bar = tqdm(todo, desc=f"iteration {it}", disable=not progress, unit="concept")
+        for c in bar:
+            chain = Chain(vocab, model, argument_logp(settings, c), settings.delta)
+            r = explorer.search(chain, Task.from_pairs(pairs(c, "train")), settings.budget)
+            test = None
+            if r.found:
+                tp = pairs(c, "test")
+                test = (generalization(r.program, tp, DEFAULT_CONFIG.tau), len(tp))
+            run.append(_record(c, it, r, test))
+            bar.set_postfix(found=len(run.found()))
+        n_new = sum(1 for r in run.records if r["iteration"] == it and r["found"])
+        log(f"iteration {it}: {n_new} new, {len(run.found())} of {len(set(concepts))} found"
+            + (f", model with {len(vocab.bodies)} subroutines" if vocab.bodies else ""))
+        if len(run.found()) >= len(set(concepts)):
+            break
+        if n_new == 0:
+            if it > 0 and settings.subroutines and not subs_on:
+                subs_on = True  # the plain model saturated: compress from now on
+                continue
+            break
+    return run
+
+
+def summary(run: Run, concepts: Sequence[str]) -> dict:
+    recs = [r for r in run.records if r["concept"] in set(concepts)]
+    found = {r["concept"]: r for r in recs if r["found"]}
+    wall = sum(r["seconds"] for r in recs)
+    secs = wall - sum(r.get("compile_seconds", 0.0) for r in recs)
+    covered = sum(r["covered"] for r in recs)
+    exact = sum(1 for r in found.values() if r["test_correct"] == r["test_total"])
+    return {
+        "concepts": len(set(concepts)), "found": len(found), "exact_on_all_test_pairs": exact,
+        "search_seconds": round(secs, 1), "compile_seconds": round(wall - secs, 1),
+        "programs_covered": covered,
+        "programs_run": sum(r["programs_run"] for r in recs), "nodes": sum(r["nodes"] for r in recs),
+        "programs_per_second": round(covered / secs) if secs else None,
+        "programs_run_per_second": round(sum(r["programs_run"] for r in recs) / secs) if secs else None,
+        "per_iteration": {
+            it: sum(1 for r in recs if r["iteration"] == it and r["found"])
+            for it in sorted({r["iteration"] for r in recs})
+        },
+    }

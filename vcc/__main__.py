@@ -1,0 +1,5 @@
+import sys
+
+from vcc.cli import main
+
+sys.exit(main())

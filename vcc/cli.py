@@ -1,0 +1,29 @@
+"""`vcc`: one command over all packages. It sits on top: nothing below imports it."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from search import cli as search_cli
+from vccjax import cli as vccjax_cli
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="vcc",
+        description="Visual Cognitive Computer toolkit: run cognitive programs on tabletop scenes "
+                    "and induce them from examples.",
+    )
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    vccjax_cli.add_commands(sub)
+    search_cli.add_commands(sub)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    return vccjax_cli.main(argv, build_parser())
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,68 @@
+"""Spec section 7 on device: does a state's blackboard match an example's output?
+
+`scenes_match` (host) finds a one-to-one matching by shape, colour and centre within
+tau. On device a full matching is not needed: when every object has exactly one
+candidate partner on each side the matching is that one; when some object has none
+the answer is no; only when an object has two candidates (two same-looking objects
+within tau of each other, which generated scenes almost never hold) is the answer
+left to the host. So the verdict is YES, NO or ASK.
+"""
+
+from __future__ import annotations
+
+import math
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from flax import struct
+
+from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.instructions import COLORS, SHAPES
+from vccjax.scene import Scene, to_units
+from vccjax.state import SceneConst, VCCState, centres
+
+NO, YES, ASK = 0, 1, 2
+
+
+@struct.dataclass
+class Target:
+    """An example's output scene on fixed arrays (position units)."""
+
+    alive: jax.Array  # (N,) bool
+    shape: jax.Array  # (N,)
+    color: jax.Array  # (N,)
+    pos: jax.Array  # (N, 2)
+
+
+def load_target(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG) -> Target:
+    n = cfg.n_max
+    if len(scene.objects) > n:
+        raise ValueError(f"target scene has {len(scene.objects)} objects; n_max is {n}")
+    alive = np.zeros(n, bool)
+    shape = np.zeros(n, np.int32)
+    color = np.zeros(n, np.int32)
+    pos = np.zeros((n, 2), np.int32)
+    for i, o in enumerate(scene.objects):
+        alive[i] = True
+        shape[i], color[i] = SHAPES.index(o.shape), COLORS.index(o.color)
+        pos[i] = to_units(o.x, cfg), to_units(o.y, cfg)
+    return Target(jnp.asarray(alive), jnp.asarray(shape), jnp.asarray(color), jnp.asarray(pos))
+
+
+def tau_units_sq(cfg: VCCConfig) -> int:
+    """Largest squared distance in position units that is within tau (integer test)."""
+    return math.floor((cfg.tau * cfg.units) ** 2)
+
+
+def verdict(cfg: VCCConfig, c: SceneConst, s: VCCState, t: Target) -> jax.Array:
+    """NO / YES / ASK for one state against one target (not failed is checked apart)."""
+    d = centres(c, s, cfg)[:, None, :] - t.pos[None, :, :]
+    near = jnp.sum(d.astype(jnp.int32) ** 2, axis=-1) <= tau_units_sq(cfg)
+    ok = (s.alive[:, None] & t.alive[None, :] & (c.shape[:, None] == t.shape[None, :])
+          & (s.color[:, None] == t.color[None, :]) & near)
+    rows, cols = ok.sum(1), ok.sum(0)
+    same_count = s.alive.sum() == t.alive.sum()
+    missing = jnp.any(s.alive & (rows == 0)) | jnp.any(t.alive & (cols == 0))
+    unique = jnp.all(rows <= 1) & jnp.all(cols <= 1)
+    return jnp.where(~same_count | missing, NO, jnp.where(unique, YES, ASK)).astype(jnp.int32)
