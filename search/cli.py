@@ -34,12 +34,14 @@ def _concepts(spec: str) -> list[str]:
 
 
 def cmd_induce(a: argparse.Namespace) -> int:
-    from search.induce import Settings, induce, summary
+    from search.induce import Settings, argument_logp, induce, summary
     from vccjax.dataset import Dataset, build_dataset
 
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations)
     names = _concepts(a.concepts)
+    if settings.args.startswith("predicted"):
+        argument_logp(settings, names[0])  # fails now, with its message, not after building examples
     enable_compile_cache()
     folder = Path(a.dataset) if a.dataset else Path(a.out) / "dataset"
     if not a.dataset:  # examples for just these concepts (resumable, seeded)

@@ -144,8 +144,18 @@ class Explorer:
         return (_concat([o[0] for o in outs]), np.concatenate([o[1] for o in outs]),
                 np.concatenate([o[2] for o in outs]))
 
-    def _apply(self, chain: Chain, task: Task, states, portions: np.ndarray):
-        """Run each child's portion (one or more atoms) from its parent's state."""
+    # ---- the backend: what the DFS needs from a machine --------------------------------
+    def root_states(self, task: Task):
+        e = task.n_examples
+        return jax.tree.map(lambda a: np.broadcast_to(np.asarray(a), (1, e) + a.shape).copy(),
+                            init_state(self.cfg))
+
+    def take(self, states, idx: np.ndarray):
+        return _take(states, idx)
+
+    def apply(self, chain: Chain, task: Task, states, portions: np.ndarray):
+        """Run each child's portion (one or more atoms) from its parent's state; return the
+        states, whether each failed on some example, and whether it explains every one."""
         n = len(portions)
         failed = np.zeros(n, bool)
         verdicts = np.zeros((n, task.n_examples), np.int32)
@@ -160,14 +170,14 @@ class Explorer:
                 jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)
                 failed[rows] |= f
                 verdicts[rows] = v
-        return states, failed, verdicts
+        ok = ~failed & np.all(verdicts == YES, axis=1)
+        for i in np.nonzero(~failed & ~ok & np.all((verdicts == YES) | (verdicts == ASK), axis=1))[0]:
+            ok[i] = self._settle(task, states, int(i), verdicts[i])
+        return states, failed, ok
 
-    def _explains(self, task: Task, states, i: int, v: np.ndarray) -> bool:
-        if np.all(v == YES):
-            return True
-        if not np.all((v == YES) | (v == ASK)):
-            return False
-        for e, (_, out) in enumerate(task.pairs):  # rare: settle the ambiguous ones on the host
+    def _settle(self, task: Task, states, i: int, v: np.ndarray) -> bool:
+        """Rare: two same-looking objects within tau of one target; match on the host."""
+        for e, (_, out) in enumerate(task.pairs):
             if v[e] == ASK:
                 c = jax.tree.map(lambda a: a[e], task.consts)
                 s = jax.tree.map(lambda a: a[i, e], states)
@@ -184,10 +194,7 @@ class Explorer:
         below = int(table[b_star - 1]) if b_star > 0 else 0
         quota = budget - below  # programs of cost exactly b* still allowed
         cutoff = b_star
-        e = task.n_examples
-        root = jax.tree.map(lambda a: np.broadcast_to(np.asarray(a), (1, e) + a.shape).copy(),
-                            init_state(self.cfg))
-        frames = [_Frame(root, np.array([chain.end]), np.array([NOT_STARTED]), np.array([0]),
+        frames = [_Frame(self.root_states(task), np.array([chain.end]), np.array([NOT_STARTED]), np.array([0]),
                          np.full((1, MAX_PORTIONS), -1, np.int32), 0)]
         nodes = programs = 0
         best: tuple[int, np.ndarray] | None = None
@@ -206,8 +213,7 @@ class Explorer:
             sl = keep[: self.slice_size]
             fr.pos = int(sl[-1]) + 1
             p, zz, cc = parent[sl], z[sl], cost[sl]
-            states = _take(fr.states, p)
-            states, failed, verd = self._apply(chain, task, states, zz)
+            states, failed, ok = self.apply(chain, task, self.take(fr.states, p), zz)
             nodes += len(sl)
             tok = chain.tok[zz]
             syn = chain.next_syn[tok, fr.syn[p]]
@@ -224,7 +230,7 @@ class Explorer:
                     if quota == 0:
                         cutoff = min(cutoff, b_star - 1)
                 programs += 1
-                if self._explains(task, states, int(i), verd[i]) and (best is None or total[i] < best[0]):
+                if ok[i] and (best is None or total[i] < best[0]):
                     best = (int(total[i]), hist[i].copy())
                     cutoff = min(cutoff, int(total[i]) - 1)
             if progress:
@@ -233,7 +239,7 @@ class Explorer:
             if fr.depth + 1 < MAX_PORTIONS:
                 for part in np.array_split(np.nonzero(live)[0], max(1, -(-int(live.sum()) // self.chunk))):
                     if len(part):
-                        frames.append(_Frame(_take(states, part), tok[part], syn[part], cc[part],
+                        frames.append(_Frame(self.take(states, part), tok[part], syn[part], cc[part],
                                              hist[part], fr.depth + 1))
         seconds = time.perf_counter() - t0
         comp = self.compile_seconds - c0

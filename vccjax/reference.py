@@ -7,6 +7,7 @@ the spec's table; `docs/vcc.md` records the choices the spec leaves open.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
@@ -69,6 +70,15 @@ class RefMachine:
         self.in_loop = False
         self.loop_active = False
         self.body: list[tuple[int, int, int]] = []  # (op, arg, program index)
+
+    def clone(self) -> RefMachine:
+        """An independent copy (the scene, read-only, is shared): a search keeps one per prefix."""
+        m = copy.copy(self)
+        m.objects = [dataclasses.replace(o) for o in self.objects]
+        m.history = list(self.history)
+        m.attended_list = list(self.attended_list)
+        m.body = list(self.body)
+        return m
 
     # ---- running ------------------------------------------------------------------------
     def run(self, program: Program) -> RefMachine:

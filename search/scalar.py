@@ -1,0 +1,42 @@
+"""The same search driven by the scalar reference interpreter: the baseline that the
+batched search is measured against (`vcc bench search`), and its oracle in tests.
+
+Only the machine differs: one `RefMachine` per (prefix, example), cloned per child and
+stepped one instruction at a time. The enumeration, cutoff, budget and pruning are
+`Explorer`'s, so both visit the same programs and must find the same one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from search.chain import Chain
+from search.explore import Explorer, Task
+from vccjax.reference import RefMachine
+from vccjax.scene import scenes_match
+
+
+class ScalarExplorer(Explorer):
+    def root_states(self, task: Task):
+        return [[RefMachine(a, self.cfg, validate=False) for a, _ in task.pairs]]
+
+    def take(self, states, idx: np.ndarray):
+        return [states[i] for i in idx]
+
+    def apply(self, chain: Chain, task: Task, states, portions: np.ndarray):
+        out, failed, ok = [], np.zeros(len(portions), bool), np.zeros(len(portions), bool)
+        for i, (machines, z) in enumerate(zip(states, portions)):
+            kids = []
+            for m in machines:
+                k = m.clone()
+                for op, arg in zip(chain.ops[z], chain.args[z]):
+                    k.step(op, arg)
+                kids.append(k)
+                if k.failed:  # the program fails on this example: no need to run the rest
+                    failed[i] = True
+                    break
+            out.append(kids)
+            if not failed[i]:
+                ok[i] = all(scenes_match(k.output_scene(), b, self.cfg.tau)
+                            for k, (_, b) in zip(kids, task.pairs))
+        return out, failed, ok

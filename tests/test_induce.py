@@ -1,0 +1,134 @@
+"""Induction: the batched search agrees with the scalar-driven one, finds short concepts,
+persists after every concept and resumes without losing or redoing anything."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from search.chain import Chain, uniform_args
+from search.explore import Explorer, Task
+from search.induce import Run, Settings, argument_logp, induce
+from search.model import MarkovModel, Vocabulary
+from search.scalar import ScalarExplorer
+from vcc.cli import main
+from vccjax.concepts import reference_program
+from vccjax.dataset import Dataset, build_dataset
+from vccjax.errors import DataFileError
+
+SHORT = ["remove_bottom_obj", "change_target_obj_to_given_color", "remove_left_most_obj"]
+LONG = "swap_locations"
+
+
+@pytest.fixture(scope="module")
+def ds(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ds")
+    build_dataset(out, [*SHORT, LONG], seed=0, progress=False)
+    return Dataset(out)
+
+
+@pytest.fixture(scope="module")
+def explorer():
+    return Explorer()
+
+
+def _uniform_chain():
+    v = Vocabulary()
+    return Chain(v, MarkovModel.uniform(v.size), uniform_args())
+
+
+@pytest.mark.parametrize("concept", ["remove_bottom_obj", LONG])
+def test_batched_and_scalar_search_visit_the_same_tree(ds, explorer, concept):
+    task = Task.from_pairs(ds.pairs(concept, "train"))
+    chain = _uniform_chain()
+    a = explorer.search(chain, task, 20_000)
+    b = ScalarExplorer().search(chain, task, 20_000)
+    assert (a.found, a.text, a.rank, a.dl_bins) == (b.found, b.text, b.rank, b.dl_bins)
+    assert (a.nodes, a.programs) == (b.nodes, b.programs)
+    assert a.programs <= 20_000
+
+
+def test_brute_force_finds_the_reference_program_of_a_short_concept(ds, explorer):
+    task = Task.from_pairs(ds.pairs("remove_bottom_obj", "train"))
+    r = explorer.search(_uniform_chain(), task, 30_000)
+    assert r.found and r.program == reference_program("remove_bottom_obj")
+    assert 1 <= r.rank <= 30_000
+    # too small a budget: the program lies beyond it, so nothing is found
+    small = explorer.search(_uniform_chain(), task, r.rank - 1)
+    assert not small.found and small.programs <= r.rank - 1
+
+
+def test_oracle_arguments_exclude_unused_instructions():
+    lp = argument_logp(Settings(args="oracle"), "remove_bottom_obj")  # uses fixate(bottom) only
+    from vccjax.instructions import OP
+
+    assert (lp[OP["fixate"]] == 0).sum() == 1
+    assert all(v == float("-inf") for v in lp[OP["set_color_attn"]])
+    with pytest.raises(NotImplementedError, match="argument predictor"):
+        argument_logp(Settings(args="predicted"), "remove_bottom_obj")
+
+
+class CountingExplorer(Explorer):
+    def __init__(self, fail_after: int | None = None):
+        super().__init__()
+        self.calls: list[int] = []
+        self.fail_after = fail_after
+
+    def search(self, chain, task, budget, progress=None):
+        if self.fail_after is not None and len(self.calls) >= self.fail_after:
+            raise KeyboardInterrupt  # as if the user pressed Ctrl-C here
+        self.calls.append(task.n_examples)
+        return super().search(chain, task, budget, progress)
+
+
+def test_interrupted_run_resumes_without_losing_or_redoing(ds, tmp_path):
+    settings = Settings(budget=3000, args="oracle", max_iterations=2)
+    out = tmp_path / "run"
+    with pytest.raises(KeyboardInterrupt):
+        induce(SHORT, ds.pairs, out, settings, explorer=CountingExplorer(fail_after=2), progress=False)
+    first = [json.loads(x) for x in (out / "results.jsonl").read_text().splitlines()]
+    assert [r["concept"] for r in first] == SHORT[:2] and all(r["found"] for r in first)
+    # a line half written when the process died is dropped and its concept redone
+    with (out / "results.jsonl").open("a") as f:
+        f.write('{"concept": "remove_left_most_obj", "fou')
+    again = CountingExplorer()
+    run = induce(SHORT, ds.pairs, out, settings, explorer=again, progress=False)
+    assert len(again.calls) == 1  # only the concept not yet done
+    found = run.found()
+    assert set(found) == set(SHORT)
+    assert [found[c]["program"] for c in SHORT[:2]] == [r["program"] for r in first]
+    for r in found.values():
+        assert r["test_correct"] == r["test_total"] == 50
+        assert {"concept", "found", "program", "dl", "nodes", "rank", "seconds", "iteration"} <= set(r)
+    # the same folder with other settings is refused, not mixed
+    with pytest.raises(DataFileError, match="other settings"):
+        Run(out, Settings(budget=4000, args="oracle", max_iterations=2))
+
+
+def test_cli_induce_runs_and_reports(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("VCCJAX_CACHE", "off")
+    out = tmp_path / "cli"
+    argv = ["induce", "--concepts", "remove_bottom_obj,remove_top_obj", "--out", str(out),
+            "--budget", "2000", "--iterations", "1", "--quiet"]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "induced" in text and "programs/s" in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["found"] == 2 and summary["exact_on_all_test_pairs"] == 2
+    # rerun: everything is already there, nothing is searched again
+    assert main(argv) == 0
+    lines = (out / "results.jsonl").read_text().splitlines()
+    assert len(lines) == 2
+
+
+@pytest.mark.parametrize("argv, msg", [
+    (["induce", "--concepts", "no_such_concept", "--out", "X"], "unknown concept"),
+    (["induce", "--concepts", "remove_top_obj", "--out", "X", "--args", "predicted"], "argument predictor"),
+    (["induce", "--concepts", "remove_top_obj", "--out", "X", "--budget", "0"], "budget"),
+])
+def test_cli_induce_errors_are_one_line(tmp_path, capsys, argv, msg, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert msg in err and len(err.splitlines()) == 1
