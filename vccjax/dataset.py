@@ -31,7 +31,7 @@ from vccjax.instructions import COLORS, SHAPES
 from vccjax.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
-VERSION = 2  # 2: examples must be well posed (examples.Jitter)
+VERSION = 3  # 2: examples must be well posed (examples.Jitter); 3: small nudges too
 _FIELDS = 6  # alive, shape, color, x, y, width
 
 

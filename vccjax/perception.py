@@ -16,10 +16,11 @@ import dataclasses
 import cv2
 import numpy as np
 
+from vccjax.config import DEFAULT_CONFIG
 from vccjax.errors import SceneError
 from vccjax.instructions import SHAPES
 from vccjax.render import shape_polygon
-from vccjax.scene import Scene, SceneObject
+from vccjax.scene import Scene, SceneObject, to_units
 
 # OpenCV hue (0..180) bands of the four colours; anything saturated outside them is unknown.
 HUE_BANDS = {"red": ((0, 10), (165, 180)), "yellow": ((18, 38),), "green": ((45, 88),), "blue": ((95, 135),)}
@@ -128,10 +129,14 @@ def _labels_eq(mask: np.ndarray, stat) -> np.ndarray:
 
 def _clamp(o: SceneObject) -> SceneObject:
     """Keep an estimated box inside the workspace (estimates near an edge can overshoot)."""
-    h = o.width / 2
-    x = min(max(o.x, h), 1 - h)
-    y = min(max(o.y, h), 1 - h)
-    return dataclasses.replace(o, x=x, y=y)
+    u = DEFAULT_CONFIG.units  # clamp in the machine's integer units, as Scene.validate tests
+    w = to_units(o.width, DEFAULT_CONFIG)
+    lo, hi = -(-w // 2), (2 * u - w) // 2
+
+    def inside(v: float) -> float:
+        return min(max(to_units(v, DEFAULT_CONFIG), lo), hi) / u
+
+    return dataclasses.replace(o, x=inside(o.x), y=inside(o.y))
 
 
 def _find_pointer(hsv: np.ndarray, objects: np.ndarray) -> tuple[float, float] | None:
