@@ -29,7 +29,7 @@ import numpy as np
 
 from search.chain import NOT_STARTED, OUTSIDE, Chain, cutoff_for_budget
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.emulator import step_examples
+from vccjax.emulator import replay_examples, step_examples
 from vccjax.explain import ASK, YES, Target, load_target, verdict
 from vccjax.instructions import NAMES, OP, arg_domain
 from vccjax.program import Program
@@ -75,13 +75,20 @@ class Result:
     compile_seconds: float = 0.0  # of `seconds`, spent compiling new (op, batch size) steps
 
 
-@functools.partial(jax.jit, static_argnums=(0, 1))
-def advance(cfg: VCCConfig, op: int, consts: SceneConst, targets: Target, states, args):
+def _judge(cfg: VCCConfig, consts: SceneConst, targets: Target, states):
+    v = jax.vmap(jax.vmap(functools.partial(verdict, cfg)), in_axes=(None, 0, None))(consts, states, targets)
+    return jnp.any(states.failed, axis=1), v
+
+
+judge = jax.jit(_judge, static_argnums=0)
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1, 6))
+def advance(cfg: VCCConfig, op: int, consts: SceneConst, targets: Target, states, args, replay: bool = True):
     """Step (B, E) states by `op`; return them, whether each program failed on any
     example, and its verdict per example."""
-    new = step_examples(cfg, op, consts, states, args)
-    v = jax.vmap(jax.vmap(functools.partial(verdict, cfg)), in_axes=(None, 0, None))(consts, new, targets)
-    return new, jnp.any(new.failed, axis=1), v
+    new = step_examples(cfg, op, consts, states, args, replay)
+    return (new, *_judge(cfg, consts, targets, new))
 
 
 def _take(tree, idx: np.ndarray):
@@ -108,41 +115,75 @@ class Explorer:
     """Batched, pruned enumeration over a chain; one instance keeps its compiled steps."""
 
     def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, chunk: int = 1024, slice_size: int = 4096,
-                 buckets: Sequence[int] = (16, 64, 256, 1024, 4096),
-                 loop_end_buckets: Sequence[int] = (64, 1024)):
+                 buckets: Sequence[int] = (16, 64, 256, 1024, 4096)):
         self.cfg = cfg
         self.chunk = chunk
         self.slice_size = slice_size
         self.buckets = tuple(sorted(buckets))
-        # loop_end replays the body with every instruction's code: ~15 s to compile per
-        # size, so it gets fewer sizes than the rest
-        self.loop_end_buckets = tuple(sorted(loop_end_buckets))
-        self._compiled: set[tuple[int, int, int]] = set()
+        self._compiled: set[tuple] = set()
         self.compile_seconds = 0.0  # first calls of each (op, size): compile time, kept apart
 
     # ---- device stepping ------------------------------------------------------------
-    def _run_group(self, op: int, task: Task, states, args: np.ndarray):
-        n = len(args)
-        outs = []
-        start = 0
-        buckets = self.loop_end_buckets if op == OP["loop_end"] else self.buckets
+    def _padded(self, key, n: int, call):
+        """Run `call(idx)` over 0..n-1 in bucket-sized pieces (the last piece padded by
+        repeating its first row); time first calls of a (key, size) as compile time."""
+        outs, start = [], 0
         while start < n:
-            size = next((b for b in buckets if b >= n - start), buckets[-1])
+            size = next((b for b in self.buckets if b >= n - start), self.buckets[-1])
             take = min(size, n - start)
             idx = np.arange(start, start + take)
             pad = np.concatenate([idx, np.full(size - take, idx[0])])
-            s_in = _take(states, pad)
-            first = (op, size, task.n_examples) not in self._compiled
+            first = (key, size) not in self._compiled
             t0 = time.perf_counter()
-            new, failed, v = advance(self.cfg, op, task.consts, task.targets, s_in, jnp.asarray(args[pad]))
-            outs.append((jax.tree.map(lambda a: np.asarray(a)[:take], new),
-                         np.asarray(failed)[:take], np.asarray(v)[:take]))
+            out = jax.tree.map(lambda a: np.asarray(a)[:take], call(pad))
             if first:
-                self._compiled.add((op, size, task.n_examples))
+                self._compiled.add((key, size))
                 self.compile_seconds += time.perf_counter() - t0
+            outs.append(out)
             start += take
-        return (_concat([o[0] for o in outs]), np.concatenate([o[1] for o in outs]),
-                np.concatenate([o[2] for o in outs]))
+        return _concat(outs)
+
+    def _run_group(self, op: int, task: Task, states, args: np.ndarray):
+        e, cfg = task.n_examples, self.cfg
+        loop_end = op == OP["loop_end"]
+        new, failed, v = self._padded(
+            ("step", op, e), len(args),
+            lambda pad: advance(cfg, op, task.consts, task.targets, _take(states, pad),
+                                jnp.asarray(args[pad]), not loop_end))
+        if not loop_end:
+            return new, failed, v
+        self._replay(task, new)
+        failed, v = self._padded(("judge", e), len(args),
+                                 lambda pad: judge(cfg, task.consts, task.targets, _take(new, pad)))
+        return new, failed, v
+
+    def _replay(self, task: Task, states) -> None:
+        """A closed loop's remaining iterations, one body instruction at a time, each
+        group of programs stepped with that instruction's code only (in place)."""
+        cfg, e = self.cfg, task.n_examples
+        ops, args = states.body_ops[:, 0], states.body_args[:, 0]
+        length, pc0 = states.body_len[:, 0], states.body_pc0[:, 0]
+        iteration = 1
+        while True:
+            active = (states.loop_active & ~states.failed & (iteration < cfg.n_max)
+                      & (states.cursor < states.attn_len))
+            rows_any = active.any(axis=1)
+            if not rows_any.any():
+                return
+            for j in range(int(length[rows_any].max())):
+                live = rows_any & (length > j)
+                for op in np.unique(ops[live, j]):
+                    rows = np.nonzero(live & (ops[:, j] == op))[0]
+                    sub = _take(states, rows)
+                    act = active[rows]
+                    new = self._padded(
+                        ("replay", int(op), e), len(rows),
+                        lambda pad: replay_examples(cfg, int(op), task.consts, _take(sub, pad),  # noqa: B023
+                                                    jnp.asarray(args[rows][pad, j]),  # noqa: B023
+                                                    jnp.asarray(pc0[rows][pad] + j),  # noqa: B023
+                                                    jnp.asarray(act[pad])))  # noqa: B023
+                    jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)  # noqa: B023
+            iteration += 1
 
     # ---- the backend: what the DFS needs from a machine --------------------------------
     def root_states(self, task: Task):

@@ -19,12 +19,13 @@ from vccjax.errors import DataFileError
 
 SHORT = ["remove_bottom_obj", "change_target_obj_to_given_color", "remove_left_most_obj"]
 LONG = "swap_locations"
+LOOP = "change_all_objs_color"
 
 
 @pytest.fixture(scope="module")
 def ds(tmp_path_factory):
     out = tmp_path_factory.mktemp("ds")
-    build_dataset(out, [*SHORT, LONG], seed=0, progress=False)
+    build_dataset(out, [*SHORT, LONG, LOOP], seed=0, progress=False)
     return Dataset(out)
 
 
@@ -47,6 +48,21 @@ def test_batched_and_scalar_search_visit_the_same_tree(ds, explorer, concept):
     assert (a.found, a.text, a.rank, a.dl_bins) == (b.found, b.text, b.rank, b.dl_bins)
     assert (a.nodes, a.programs) == (b.nodes, b.programs)
     assert a.programs <= 20_000
+
+
+def test_loops_replayed_on_the_host_agree_with_the_scalar_search(ds, explorer):
+    """A model that likes loops (fitted on the reference programs: only to make loops
+    likely here) so that `loop_end` and its host-driven replay are exercised."""
+    from vccjax.concepts import all_concepts
+
+    v = Vocabulary()
+    model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], v.size, 1, 0.1)
+    chain = Chain(v, model, argument_logp(Settings(args="oracle"), LOOP))
+    task = Task.from_pairs(ds.pairs(LOOP, "train"))
+    a = explorer.search(chain, task, 3000)
+    b = ScalarExplorer().search(chain, task, 3000)
+    assert a.found and "loop_end" in a.text
+    assert (a.text, a.rank, a.nodes, a.programs) == (b.text, b.rank, b.nodes, b.programs)
 
 
 def test_brute_force_finds_the_reference_program_of_a_short_concept(ds, explorer):

@@ -281,9 +281,10 @@ def _execute_switch(cfg, c, s, op, arg, pc, branches) -> VCCState:
     return jax.lax.switch(idx, fns, c, s, arg, pc)
 
 
-def _step(cfg: VCCConfig, c: SceneConst, s: VCCState, op, arg, execute) -> VCCState:
-    """Loop bookkeeping of spec section 5 around one instruction; `op` static or traced."""
-    may_end_loop = not isinstance(op, int) or op == OP["loop_end"]
+def _step(cfg: VCCConfig, c: SceneConst, s: VCCState, op, arg, execute, replay: bool = True) -> VCCState:
+    """Loop bookkeeping of spec section 5 around one instruction; `op` static or traced.
+    replay=False leaves a closed loop's remaining iterations to the caller (`replay_examples`)."""
+    may_end_loop = (not isinstance(op, int) or op == OP["loop_end"]) and replay
     op = jnp.asarray(op, jnp.int32)
     pc = s.pc
     recording = s.in_loop & (op != OP["loop_end"])
@@ -310,10 +311,10 @@ def step(cfg: VCCConfig, c: SceneConst, s: VCCState, op, arg) -> VCCState:
                  lambda c_, s_, a_, pc_: _execute_switch(cfg, c_, s_, op, a_, pc_, _TOP_BRANCHES))
 
 
-def step_op(cfg: VCCConfig, op: int, c: SceneConst, s: VCCState, arg, fn=None) -> VCCState:
+def step_op(cfg: VCCConfig, op: int, c: SceneConst, s: VCCState, arg, fn=None, replay: bool = True) -> VCCState:
     """One program instruction with a static op: only that op's code is traced."""
     return _step(cfg, c, s, op, arg,
-                 lambda c_, s_, a_, pc_: _execute(cfg, op, c_, s_, a_, pc_, fn))
+                 lambda c_, s_, a_, pc_: _execute(cfg, op, c_, s_, a_, pc_, fn), replay)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 1))
@@ -331,15 +332,19 @@ def step_batch(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, ar
     )
 
 
-@functools.partial(jax.jit, static_argnums=(0, 1))
-def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, args: jax.Array) -> VCCState:
+@functools.partial(jax.jit, static_argnums=(0, 1, 5))
+def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, args: jax.Array,
+                  replay: bool = True) -> VCCState:
     """Step B programs' states on the same E examples by one static op.
 
     consts: (E, ...) the examples' scenes; states: (B, E, ...); args: (B,). The scenes
-    are shared, not copied per program: this is the layout the search steps in."""
+    are shared, not copied per program: this is the layout the search steps in.
+    With replay=False a `loop_end` only closes the loop: the caller replays the body
+    with `loop_iterations_left` and `replay_examples` (one static op at a time, instead
+    of every instruction's code in a traced loop)."""
 
     def per_program(fn):
-        one = functools.partial(step_op, cfg, op, fn=fn)
+        one = functools.partial(step_op, cfg, op, fn=fn, replay=replay)
         return jax.vmap(jax.vmap(one, in_axes=(0, 0, None)), in_axes=(None, 0, 0))
 
     if op != OP["move_hand_to_attended_object"]:
@@ -347,6 +352,25 @@ def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState,
     approach = functools.partial(_hand_to_attended, carry=False)
     return jax.lax.cond(jnp.any(states.held >= 0), per_program(None), per_program(approach),
                         consts, states, args)
+
+
+def loop_needs_iteration(cfg: VCCConfig, s: VCCState, iteration) -> jax.Array:
+    """Whether a just-closed loop runs another iteration (`iteration` = iterations done;
+    spec section 5: while k < len(A), at most n_max in all, the first ran eagerly)."""
+    return s.loop_active & ~s.failed & (iteration < cfg.n_max) & (s.cursor < s.attn_len)
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1))
+def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, args: jax.Array,
+                    pcs: jax.Array, active: jax.Array) -> VCCState:
+    """One body instruction of a replayed loop, static op, for states where `active`
+    (B, E); the others are returned unchanged. args, pcs: (B,)."""
+
+    def one(c, s, arg, pc, act):
+        return _select(act & ~s.failed, _execute(cfg, op, c, s, arg, pc), s)
+
+    f = jax.vmap(jax.vmap(one, in_axes=(0, 0, None, None, 0)), in_axes=(None, 0, 0, 0, 0))
+    return f(consts, states, args, pcs, active)
 
 
 def _run(cfg, c, ops, args):

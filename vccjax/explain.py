@@ -10,8 +10,6 @@ left to the host. So the verdict is YES, NO or ASK.
 
 from __future__ import annotations
 
-import math
-
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -19,7 +17,7 @@ from flax import struct
 
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.instructions import COLORS, SHAPES
-from vccjax.scene import Scene, to_units
+from vccjax.scene import Scene
 from vccjax.state import SceneConst, VCCState, centres
 
 NO, YES, ASK = 0, 1, 2
@@ -32,7 +30,7 @@ class Target:
     alive: jax.Array  # (N,) bool
     shape: jax.Array  # (N,)
     color: jax.Array  # (N,)
-    pos: jax.Array  # (N, 2)
+    pos: jax.Array  # (N, 2) float32 position units (a loaded scene need not sit on the grid)
 
 
 def load_target(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG) -> Target:
@@ -42,27 +40,28 @@ def load_target(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG) -> Target:
     alive = np.zeros(n, bool)
     shape = np.zeros(n, np.int32)
     color = np.zeros(n, np.int32)
-    pos = np.zeros((n, 2), np.int32)
+    pos = np.zeros((n, 2), np.float32)
     for i, o in enumerate(scene.objects):
         alive[i] = True
         shape[i], color[i] = SHAPES.index(o.shape), COLORS.index(o.color)
-        pos[i] = to_units(o.x, cfg), to_units(o.y, cfg)
+        pos[i] = o.x * cfg.units, o.y * cfg.units
     return Target(jnp.asarray(alive), jnp.asarray(shape), jnp.asarray(color), jnp.asarray(pos))
 
 
-def tau_units_sq(cfg: VCCConfig) -> int:
-    """Largest squared distance in position units that is within tau (integer test)."""
-    return math.floor((cfg.tau * cfg.units) ** 2)
+BAND = 0.25  # squared position units around tau where float32 is not trusted: ASK
 
 
 def verdict(cfg: VCCConfig, c: SceneConst, s: VCCState, t: Target) -> jax.Array:
     """NO / YES / ASK for one state against one target (not failed is checked apart)."""
-    d = centres(c, s, cfg)[:, None, :] - t.pos[None, :, :]
-    near = jnp.sum(d.astype(jnp.int32) ** 2, axis=-1) <= tau_units_sq(cfg)
-    ok = (s.alive[:, None] & t.alive[None, :] & (c.shape[:, None] == t.shape[None, :])
-          & (s.color[:, None] == t.color[None, :]) & near)
+    d = centres(c, s, cfg).astype(jnp.float32)[:, None, :] - t.pos[None, :, :]
+    d2 = jnp.sum(d * d, axis=-1)
+    tau2 = (cfg.tau * cfg.units) ** 2
+    same = (s.alive[:, None] & t.alive[None, :] & (c.shape[:, None] == t.shape[None, :])
+            & (s.color[:, None] == t.color[None, :]))
+    ok = same & (d2 <= tau2 - BAND)
+    unsure = jnp.any(same & (jnp.abs(d2 - tau2) < BAND))  # on the edge of tau: the host decides
     rows, cols = ok.sum(1), ok.sum(0)
     same_count = s.alive.sum() == t.alive.sum()
     missing = jnp.any(s.alive & (rows == 0)) | jnp.any(t.alive & (cols == 0))
     unique = jnp.all(rows <= 1) & jnp.all(cols <= 1)
-    return jnp.where(~same_count | missing, NO, jnp.where(unique, YES, ASK)).astype(jnp.int32)
+    return jnp.where(~same_count, NO, jnp.where(unsure | ~unique, ASK, jnp.where(missing, NO, YES))).astype(jnp.int32)
