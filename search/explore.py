@@ -29,7 +29,7 @@ import numpy as np
 
 from search.chain import NOT_STARTED, OUTSIDE, Chain, cutoff_for_budget
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.emulator import replay_examples, step_examples
+from vccjax.emulator import loop_needs_iteration, replay_examples, step_examples
 from vccjax.explain import ASK, YES, Target, load_target, verdict
 from vccjax.instructions import NAMES, OP, arg_domain
 from vccjax.program import Program
@@ -107,7 +107,7 @@ class _Frame:
     cost: np.ndarray  # (n,) bins so far (no end)
     hist: np.ndarray  # (n, MAX_PORTIONS) portion indices, -1 padded
     depth: int
-    kids: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # parent, portion, cost
+    kids: tuple[np.ndarray, ...] | None = None  # parent, portion, cost, cheapest completion
     pos: int = 0
 
 
@@ -165,8 +165,7 @@ class Explorer:
         length, pc0 = states.body_len[:, 0], states.body_pc0[:, 0]
         iteration = 1
         while True:
-            active = (states.loop_active & ~states.failed & (iteration < cfg.n_max)
-                      & (states.cursor < states.attn_len))
+            active = loop_needs_iteration(cfg, states, iteration)  # host arrays: (n, E)
             rows_any = active.any(axis=1)
             if not rows_any.any():
                 return
@@ -244,10 +243,8 @@ class Explorer:
             fr = frames[-1]
             if fr.kids is None:
                 fr.kids = self._children(chain, fr, cutoff)
-            parent, z, cost = fr.kids
-            keep = np.nonzero(cost[fr.pos :] + chain.min_rest[chain.tok[z[fr.pos :]],
-                                                              chain.next_syn[chain.tok[z[fr.pos :]], fr.syn[parent[fr.pos :]]]]
-                              <= cutoff)[0] + fr.pos
+            parent, z, cost, bound = fr.kids
+            keep = np.nonzero(bound[fr.pos :] <= cutoff)[0] + fr.pos  # the cutoff may have dropped
             if len(keep) == 0:
                 frames.pop()
                 continue
@@ -294,16 +291,13 @@ class Explorer:
         )
 
     def _children(self, chain: Chain, fr: _Frame, cutoff: int):
-        n, zs = len(fr.last), np.arange(chain.n_portions)
         cost = fr.cost[:, None] + chain.trans_bins[fr.last[:, None], chain.tok[None, :]] + chain.argbins[None, :]
         syn = chain.next_syn[chain.tok[None, :], fr.syn[:, None]]
-        rest = chain.min_rest[chain.tok[None, :], np.maximum(syn, 0)]
-        ok = (syn >= 0) & (cost + rest <= cutoff)
-        parent, z = np.nonzero(ok)
-        c = cost[parent, z]
-        order = np.argsort(c, kind="stable")  # the most probable children first
-        del n, zs
-        return parent[order], z[order], c[order]
+        bound = cost + chain.min_rest[chain.tok[None, :], np.maximum(syn, 0)]
+        parent, z = np.nonzero((syn >= 0) & (bound <= cutoff))
+        order = np.argsort(cost[parent, z], kind="stable")  # the most probable children first
+        parent, z = parent[order], z[order]
+        return parent, z, cost[parent, z], bound[parent, z]
 
     @staticmethod
     def program(chain: Chain, portions: Sequence[int]) -> Program:

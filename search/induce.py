@@ -59,8 +59,13 @@ class Settings:
             raise ValueError("--budget must be positive")
 
 
-def _values_used(program: Program, op: int) -> set[int]:
-    return {a for o, a in zip(program.ops, program.args) if o == op}
+def _uniform_over_used(program: Program, name: str) -> np.ndarray:
+    """log p uniform over the values `program` gives instruction `name`; -inf elsewhere."""
+    used = sorted({a for o, a in zip(program.ops, program.args) if o == OP[name]})
+    lp = np.full(len(arg_domain(name)), -np.inf)
+    if used:
+        lp[used] = -math.log(len(used))
+    return lp
 
 
 def argument_logp(settings: Settings, concept: str) -> dict[int, np.ndarray]:
@@ -77,22 +82,10 @@ def argument_logp(settings: Settings, concept: str) -> dict[int, np.ndarray]:
         )
     ref = reference_program(concept)
     if mode == "oracle":
-        out = {}
-        for name in NAMES:
-            if dom := arg_domain(name):
-                used = _values_used(ref, OP[name])
-                lp = np.full(len(dom), -np.inf)
-                if used:
-                    lp[sorted(used)] = -math.log(len(used))
-                out[OP[name]] = lp
-        return out
+        return {OP[name]: _uniform_over_used(ref, name) for name in NAMES if arg_domain(name)}
     out = uniform_args()
     if mode.endswith("+fixation"):
-        used = _values_used(ref, OP["fixate"])
-        lp = np.full(len(arg_domain("fixate")), -np.inf)
-        if used:
-            lp[sorted(used)] = -math.log(len(used))
-        out[OP["fixate"]] = lp
+        out[OP["fixate"]] = _uniform_over_used(ref, "fixate")
     return out
 
 

@@ -320,16 +320,18 @@ def step_op(cfg: VCCConfig, op: int, c: SceneConst, s: VCCState, arg, fn=None, r
 @functools.partial(jax.jit, static_argnums=(0, 1))
 def step_batch(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, args: jax.Array) -> VCCState:
     """Step a batch of states (each with its own scene) by the same instruction."""
-    full = jax.vmap(functools.partial(step_op, cfg, op))
+    return _batched(cfg, op, lambda fn: jax.vmap(functools.partial(step_op, cfg, op, fn=fn)),
+                    consts, states, args)
+
+
+def _batched(cfg: VCCConfig, op: int, make, consts, states, *rest):
+    """`make(fn)` builds the batched step with `fn` standing in for the op's function.
+    Approaching an object with an empty hand is cheap, carrying one is not: for
+    move_hand_to_attended_object pay for the carry only when some state holds an object."""
     if op != OP["move_hand_to_attended_object"]:
-        return full(consts, states, args)
-    # approaching an object (empty hand) is cheap, carrying one is not: pay for the carry
-    # only when some state in the batch holds an object
+        return make(None)(consts, states, *rest)
     approach = functools.partial(_hand_to_attended, carry=False)
-    return jax.lax.cond(
-        jnp.any(states.held >= 0), full,
-        jax.vmap(functools.partial(step_op, cfg, op, fn=approach)), consts, states, args,
-    )
+    return jax.lax.cond(jnp.any(states.held >= 0), make(None), make(approach), consts, states, *rest)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 1, 5))
@@ -347,11 +349,7 @@ def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState,
         one = functools.partial(step_op, cfg, op, fn=fn, replay=replay)
         return jax.vmap(jax.vmap(one, in_axes=(0, 0, None)), in_axes=(None, 0, 0))
 
-    if op != OP["move_hand_to_attended_object"]:
-        return per_program(None)(consts, states, args)
-    approach = functools.partial(_hand_to_attended, carry=False)
-    return jax.lax.cond(jnp.any(states.held >= 0), per_program(None), per_program(approach),
-                        consts, states, args)
+    return _batched(cfg, op, per_program, consts, states, args)
 
 
 def loop_needs_iteration(cfg: VCCConfig, s: VCCState, iteration) -> jax.Array:
