@@ -29,7 +29,7 @@ import numpy as np
 
 from search.chain import NOT_STARTED, OUTSIDE, Chain, cutoff_for_budget
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.emulator import loop_needs_iteration, replay_examples, step_examples
+from vccjax.emulator import EMPTY_HANDED, loop_needs_iteration, replay_examples, step_examples
 from vccjax.explain import ASK, YES, Target, load_target, verdict
 from vccjax.instructions import NAMES, OP, arg_domain
 from vccjax.program import Program
@@ -143,7 +143,26 @@ class Explorer:
             start += take
         return _concat(outs)
 
+    @staticmethod
+    def _holding_parts(op: int, held: np.ndarray) -> list[np.ndarray]:
+        """Rows of a group split into those where some example holds an object and the
+        rest, for a carry op (the rest then skip the carry: `emulator.EMPTY_HANDED`)."""
+        if op not in EMPTY_HANDED:
+            return [np.arange(len(held))]
+        holding = (held >= 0).any(axis=1)
+        return [part for part in (np.nonzero(holding)[0], np.nonzero(~holding)[0]) if len(part)]
+
     def _run_group(self, op: int, task: Task, states, args: np.ndarray):
+        parts = self._holding_parts(op, states.held)
+        if len(parts) == 1:
+            return self._run_part(op, task, states, args)
+        outs = [(idx, self._run_part(op, task, _take(states, idx), args[idx])) for idx in parts]
+        merged = jax.tree.map(lambda a: np.empty((len(args),) + a.shape[1:], a.dtype), outs[0][1])
+        for idx, out in outs:
+            jax.tree.map(lambda dst, src: dst.__setitem__(idx, src), merged, out)  # noqa: B023
+        return merged
+
+    def _run_part(self, op: int, task: Task, states, args: np.ndarray):
         e, cfg = task.n_examples, self.cfg
         loop_end = op == OP["loop_end"]
         new, failed, v = self._padded(
@@ -160,7 +179,7 @@ class Explorer:
     def _replay(self, task: Task, states) -> None:
         """A closed loop's remaining iterations, one body instruction at a time, each
         group of programs stepped with that instruction's code only (in place)."""
-        cfg, e = self.cfg, task.n_examples
+        cfg = self.cfg
         ops, args = states.body_ops[:, 0], states.body_args[:, 0]
         length, pc0 = states.body_len[:, 0], states.body_pc0[:, 0]
         iteration = 1
@@ -172,17 +191,20 @@ class Explorer:
             for j in range(int(length[rows_any].max())):
                 live = rows_any & (length > j)
                 for op in np.unique(ops[live, j]):
-                    rows = np.nonzero(live & (ops[:, j] == op))[0]
-                    sub = _take(states, rows)
-                    act = active[rows]
-                    new = self._padded(
-                        ("replay", int(op), e), len(rows),
-                        lambda pad: replay_examples(cfg, int(op), task.consts, _take(sub, pad),  # noqa: B023
-                                                    jnp.asarray(args[rows][pad, j]),  # noqa: B023
-                                                    jnp.asarray(pc0[rows][pad] + j),  # noqa: B023
-                                                    jnp.asarray(act[pad])))  # noqa: B023
-                    jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)  # noqa: B023
+                    group = np.nonzero(live & (ops[:, j] == op))[0]
+                    for part in self._holding_parts(int(op), states.held[group]):
+                        self._replay_rows(task, states, int(op), group[part], args, pc0, active, j)
             iteration += 1
+
+    def _replay_rows(self, task: Task, states, op: int, rows: np.ndarray, args, pc0, active, j: int) -> None:
+        cfg, e = self.cfg, task.n_examples
+        sub = _take(states, rows)
+        act = active[rows]
+        new = self._padded(
+            ("replay", op, e), len(rows),
+            lambda pad: replay_examples(cfg, op, task.consts, _take(sub, pad), jnp.asarray(args[rows][pad, j]),
+                                        jnp.asarray(pc0[rows][pad] + j), jnp.asarray(act[pad])))
+        jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)
 
     # ---- the backend: what the DFS needs from a machine --------------------------------
     def root_states(self, task: Task):

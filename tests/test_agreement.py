@@ -18,7 +18,7 @@ from conftest import summary_jax, summary_ref
 from vccjax import emulator
 from vccjax.config import DEFAULT_CONFIG as CFG
 from vccjax.generate import random_deep_program, random_program, random_scene
-from vccjax.instructions import N_OPS
+from vccjax.instructions import N_OPS, NAMES
 from vccjax.reference import RefMachine
 from vccjax.scene import scenes_match
 from vccjax.state import init_state, load_scene, output_scene, stack
@@ -177,3 +177,27 @@ def test_derived_raster_masks_and_grid_match_the_reference_pixels():
         assert (np.asarray(imagined_mask(st, CFG)) == imag).all()
         checked += 1
     assert checked >= 20
+
+
+@pytest.mark.parametrize("holding", [False, True])
+def test_carry_ops_skip_the_carry_only_when_nothing_is_held(holding):
+    """`emulator.EMPTY_HANDED`: a batch with no object held runs a cheaper stand-in; it
+    must give what the full op gives (and what the reference gives)."""
+    from vccjax.program import parse
+
+    rng = np.random.default_rng(21)
+    scenes = [random_scene(rng, (2, 6), pointer=True) for _ in range(16)]
+    prefix = "scene_parse; top_down_attend; fixate_attended_object; move_hand_to_attended_object"
+    prefix += "; grab_object" if holding else ""
+    consts = stack([load_scene(s) for s in scenes])
+    states = emulator.run_batch(CFG, consts, *(jnp.asarray(a) for a in parse(prefix).arrays(LENGTH)[:2]))
+    assert bool(jnp.any(states.held >= 0)) == holding
+    for op in emulator.EMPTY_HANDED:
+        batched = emulator.step_batch(CFG, op, consts, states, jnp.zeros(len(scenes), jnp.int32))
+        full = jax.vmap(lambda c, s, op=op: emulator.step_op(CFG, op, c, s, jnp.int32(0)))(consts, states)
+        host_b, host_f, host_c = jax.device_get((batched, full, consts))
+        for i, sc in enumerate(scenes):
+            pick = lambda t, i=i: jax.tree.map(lambda x: x[i], t)  # noqa: E731
+            ref = RefMachine(sc).run(parse(f"{prefix}; {NAMES[op]}"))
+            assert summary_jax(pick(host_b), pick(host_c)) == summary_jax(pick(host_f), pick(host_c))
+            assert summary_jax(pick(host_b), pick(host_c)) == summary_ref(ref)

@@ -143,7 +143,7 @@ def test_examples_survive_rendering_and_parsing(small):
     from vccjax.perception_eval import end_to_end
 
     r = end_to_end(str(small), "varied", pairs=20, concepts=SOME, progress=False)
-    assert r["concepts_at_least_99pct"] == len(SOME), r["worst"]
+    assert r["concepts_at_least_99pct"] == len(SOME), r["misses"]
 
 
 def test_image_pairs_render_both_sides(small):

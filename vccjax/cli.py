@@ -141,7 +141,7 @@ def cmd_perception_evaluate(a: argparse.Namespace) -> int:
 
     for style in a.styles.split(","):
         if a.dataset:
-            r = end_to_end(a.dataset, style, pairs=a.pairs, size=a.size)
+            r = end_to_end(a.dataset, style, pairs=a.pairs, size=a.size, workers=a.workers)
         else:
             r = evaluate(a.images, style, seed=a.seed, size=a.size)
         print(json.dumps(r))
@@ -195,6 +195,7 @@ def add_commands(sub) -> None:
     ev.add_argument("--size", type=int, default=384, help="image size in pixels (default 384)")
     ev.add_argument("--dataset", help="a built dataset folder: run the end-to-end check instead")
     ev.add_argument("--pairs", type=int, default=50, help="test pairs per concept (end to end)")
+    ev.add_argument("--workers", type=int, default=1, help="processes for the end-to-end check")
     ev.set_defaults(fn=cmd_perception_evaluate)
     c = sub.add_parser("concepts", help="list the 546 concepts with their program lengths")
     c.add_argument("pattern", nargs="?", help="only names containing this")

@@ -31,7 +31,8 @@ from vccjax.instructions import COLORS, SHAPES
 from vccjax.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
-VERSION = 3  # 2: examples must be well posed (examples.Jitter); 3: small nudges too
+VERSION = 5  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
+# 4: drawn shapes kept apart (generate.drawn_cover), whole-scene and pointer nudges; 5: each object nudged alone
 _FIELDS = 6  # alive, shape, color, x, y, width
 
 

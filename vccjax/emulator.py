@@ -324,14 +324,25 @@ def step_batch(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, ar
                     consts, states, args)
 
 
+def _fails_empty_handed(cfg, c, s, arg):
+    return s, jnp.bool_(True)
+
+
+# Carrying is the costly part of a hand move, and it only happens with an object held:
+# when no state in a batch holds one, these ops run a stand-in with the same outcome.
+EMPTY_HANDED = {
+    OP["move_hand_to_attended_object"]: functools.partial(_hand_to_attended, carry=False),
+    OP["move_hand_to_pointer"]: _fails_empty_handed,
+    OP["move_hand_to_fixate_collision"]: _fails_empty_handed,
+}
+
+
 def _batched(cfg: VCCConfig, op: int, make, consts, states, *rest):
-    """`make(fn)` builds the batched step with `fn` standing in for the op's function.
-    Approaching an object with an empty hand is cheap, carrying one is not: for
-    move_hand_to_attended_object pay for the carry only when some state holds an object."""
-    if op != OP["move_hand_to_attended_object"]:
+    """`make(fn)` builds the batched step with `fn` standing in for the op's function;
+    a carry op pays for the carry only when some state in the batch holds an object."""
+    if op not in EMPTY_HANDED:
         return make(None)(consts, states, *rest)
-    approach = functools.partial(_hand_to_attended, carry=False)
-    return jax.lax.cond(jnp.any(states.held >= 0), make(None), make(approach), consts, states, *rest)
+    return jax.lax.cond(jnp.any(states.held >= 0), make(None), make(EMPTY_HANDED[op]), consts, states, *rest)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 1, 5))
@@ -364,11 +375,13 @@ def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCStat
     """One body instruction of a replayed loop, static op, for states where `active`
     (B, E); the others are returned unchanged. args, pcs: (B,)."""
 
-    def one(c, s, arg, pc, act):
-        return _select(act & ~s.failed, _execute(cfg, op, c, s, arg, pc), s)
+    def per_program(fn):
+        def one(c, s, arg, pc, act):
+            return _select(act & ~s.failed, _execute(cfg, op, c, s, arg, pc, fn), s)
 
-    f = jax.vmap(jax.vmap(one, in_axes=(0, 0, None, None, 0)), in_axes=(None, 0, 0, 0, 0))
-    return f(consts, states, args, pcs, active)
+        return jax.vmap(jax.vmap(one, in_axes=(0, 0, None, None, 0)), in_axes=(None, 0, 0, 0, 0))
+
+    return _batched(cfg, op, per_program, consts, states, args, pcs, active)
 
 
 def _run(cfg, c, ops, args):

@@ -10,10 +10,45 @@ import numpy as np
 
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import SceneError
-from vccjax.instructions import COLORS, SHAPES
 from vccjax.geometry import object_pixels
+from vccjax.instructions import COLORS, SHAPES
+from vccjax.render import shape_polygon
 from vccjax.scene import Scene, SceneObject, box_inside, to_units
 
+
+_FINE = 8  # subdivisions per raster pixel when finding what a drawn shape covers
+
+
+def drawn_cover(shape: str, width: float, x: float, y: float, cfg: VCCConfig = DEFAULT_CONFIG):
+    """(rows, cols) of the raster pixels that the drawn shape touches: a superset of the
+    machine's mask, whose pixels are those with their *centre* inside. A star's thin tips
+    cross pixels whose centres lie outside it, so masks alone under-state how close two
+    drawn shapes come."""
+    r = cfg.raster
+    reach = int(np.ceil(width / 2 * r)) + 2
+    qx, qy = int(x * r), int(y * r)
+    if shape == "circle":  # exact: a pixel is touched if its nearest point is within the radius
+        ii = np.arange(qy - reach, qy + reach + 1)
+        jj = np.arange(qx - reach, qx + reach + 1)
+        dy = np.clip(y * r, ii, ii + 1) - y * r
+        dx = np.clip(x * r, jj, jj + 1) - x * r
+        rows, cols = np.nonzero(dy[:, None] ** 2 + dx[None, :] ** 2 <= (width / 2 * r) ** 2)
+        return rows + qy - reach, cols + qx - reach
+    # polygons: the pixels the outline passes through (sampled every 1/32 pixel) and the
+    # interior (filled at _FINE x the raster; any touched sub-pixel counts)
+    n = (2 * reach + 1) * _FINE
+    fine = np.zeros((n, n), np.uint8)
+    ox, oy = (qx - reach) / r, (qy - reach) / r  # the window's corner, in workspace units
+    poly = shape_polygon(shape, x - ox, y - oy, width, r * _FINE) - 0.5
+    cv2.fillPoly(fine, [np.round(poly * 16).astype(np.int32)], 1, cv2.LINE_8, 4)
+    touched = fine.reshape(2 * reach + 1, _FINE, 2 * reach + 1, _FINE).max(axis=(1, 3))
+    corners = shape_polygon(shape, x, y, width, r)
+    step = np.roll(corners, -1, axis=0) - corners
+    t = np.linspace(0.0, 1.0, int(np.ceil(np.abs(step).max() * 32)) + 2)[:, None, None]
+    pix = np.floor(corners + t * step).astype(int).reshape(-1, 2)
+    touched[pix[:, 1] - qy + reach, pix[:, 0] - qx + reach] = 1
+    rows, cols = np.nonzero(touched)
+    return rows + qy - reach, cols + qx - reach
 
 def random_scene(
     rng: np.random.Generator,
@@ -28,9 +63,10 @@ def random_scene(
 ) -> Scene:
     """A valid scene: objects drawn uniformly, placed by rejection.
 
-    Generated inputs keep `gap` raster pixels between objects' masks (so that their
-    drawn shapes never touch, as in the paper's figures, and an image parser can tell
-    them apart), and the pointer `pointer_clearance` pixels away from every object.
+    Generated inputs keep `gap` raster pixels between the pixels objects' drawn shapes
+    touch (`drawn_cover`, a superset of their masks), so that drawn shapes never touch,
+    as in the paper's figures, and an image parser can tell them apart; the pointer
+    stays `pointer_clearance` pixels away from every object.
     """
     if isinstance(n_objects, tuple):
         n = int(rng.integers(n_objects[0], n_objects[1] + 1))
@@ -50,6 +86,11 @@ def random_scene(
             if not box_inside(to_units(x, cfg), to_units(y, cfg), to_units(w, cfg), cfg):
                 continue
             rows, cols = object_pixels(cand.shape, w, to_units(x, cfg), to_units(y, cfg), cfg)
+            if blocked[rows, cols].any():
+                continue
+            rows, cols = drawn_cover(cand.shape, w, x, y, cfg)
+            keep = (rows >= 0) & (rows < r) & (cols >= 0) & (cols < r)
+            rows, cols = rows[keep], cols[keep]
             if blocked[rows, cols].any():
                 continue
             objs.append(cand)
