@@ -147,7 +147,7 @@ def is_well_posed(
 
 def make_pairs(
     program: Program, spec: ExampleSpec, rng: np.random.Generator,
-    cfg: VCCConfig = DEFAULT_CONFIG, max_tries: int = 5000, jitter: Jitter | None = Jitter(),
+    cfg: VCCConfig = DEFAULT_CONFIG, max_tries: int = 30000, jitter: Jitter | None = Jitter(),
 ) -> list[tuple[Scene, Scene]]:
     """`spec.count` well-posed (input, output) pairs on which the program runs and changes
     the scene. `jitter=None` skips the well-posedness rule."""

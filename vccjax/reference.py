@@ -10,6 +10,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 
+import numpy as np
+
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.geometry import imagined_pixels, object_pixels
 from vccjax.instructions import (
@@ -187,13 +189,25 @@ class RefMachine:
         o = self.objects[i]
         s = self.cfg.sub
         w = to_units(o.width, self.cfg)
-        blocked = self.imagined_set()
+        # the other objects' and the imagined pixels on a raster with a wide margin (masks
+        # may reach past the workspace); the held object moves by whole pixels, so its
+        # mask at offset (dx, dy) is its mask now shifted by (dy, dx) rows and columns
+        m = 2 * self.cfg.raster
+        blocked = np.zeros((5 * self.cfg.raster,) * 2, bool)
+        if self.imagined is not None:
+            rows, cols = imagined_pixels(*self.imagined, self.cfg)
+            blocked[rows + m, cols + m] = True
         for j in self.real_alive():
             if j != i:
-                blocked |= self.pixels(j)
+                q = self.objects[j]
+                rows, cols = object_pixels(q.shape, q.width, q.x, q.y, self.cfg)
+                blocked[rows + m, cols + m] = True
+        rows, cols = object_pixels(o.shape, o.width, o.x, o.y, self.cfg)
+        steps = np.asarray(path[1:], np.int64).reshape(-1, 2)
+        hits = blocked[rows[None, :] + m + steps[:, 1:], cols[None, :] + m + steps[:, :1]].any(axis=1)
         last = (0, 0)
-        for dx, dy in path[1:]:
-            if not box_inside(o.x + dx * s, o.y + dy * s, w, self.cfg) or self.pixels(i, dx, dy) & blocked:
+        for (dx, dy), hit in zip(steps.tolist(), hits.tolist()):
+            if hit or not box_inside(o.x + dx * s, o.y + dy * s, w, self.cfg):
                 break
             last = (dx, dy)
         o.x += last[0] * s
