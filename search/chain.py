@@ -14,6 +14,7 @@ the instructions banned in it; a program may end only outside a loop.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import itertools
 import math
 from collections.abc import Mapping
@@ -188,8 +189,23 @@ class Chain:
         return total + float(self.trans_nats[last, self.end])
 
 
+_TABLES: dict[bytes, np.ndarray] = {}
+
+
 def cutoff_for_budget(chain: Chain, budget: int) -> tuple[int, np.ndarray]:
     """The description-length cutoff (bins) of the `budget` most probable programs, and the
-    cumulative count table (rank of a program of cost b = table[b - 1] + 1)."""
-    table = chain.count_table(budget)
+    cumulative count table (rank of a program of cost b = table[b - 1] + 1).
+
+    The table depends only on the model's transition costs, the syntax and how many
+    portions each token has at each argument cost, so concepts whose argument
+    distributions differ only in which values they favour share it (cached)."""
+    key = hashlib.sha256(b"".join(np.ascontiguousarray(a).tobytes() for a in (
+        np.array([budget, chain.end]), chain.trans_bins, chain.next_syn,
+        np.unique(chain.tok.astype(np.int64) * (1 << 32) + chain.argbins, return_counts=True)[1],
+        np.unique(chain.tok.astype(np.int64) * (1 << 32) + chain.argbins)))).digest()
+    if key not in _TABLES:
+        if len(_TABLES) > 256:
+            _TABLES.clear()
+        _TABLES[key] = chain.count_table(budget)
+    table = _TABLES[key]
     return len(table) - 1, table

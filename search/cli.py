@@ -20,7 +20,7 @@ def enable_compile_cache() -> None:
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
 
 
-def _concepts(spec: str) -> list[str]:
+def concept_list(spec: str) -> list[str]:
     from vccjax.concepts import concept_names
 
     names = concept_names()
@@ -39,7 +39,7 @@ def cmd_induce(a: argparse.Namespace) -> int:
 
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations)
-    names = _concepts(a.concepts)
+    names = concept_list(a.concepts)
     if settings.args.startswith("predicted"):
         argument_logp(settings, names[0])  # fails now, with its message, not after building examples
     enable_compile_cache()
@@ -51,7 +51,9 @@ def cmd_induce(a: argparse.Namespace) -> int:
     if missing:
         raise ValueError(f"{folder}: no examples for {', '.join(missing[:5])}"
                          + (" ..." if len(missing) > 5 else ""))
-    run = induce(names, ds.pairs, a.out, settings, progress=not a.quiet)
+    from search.explore import Explorer
+
+    run = induce(names, ds.pairs, a.out, settings, explorer=Explorer(width=a.width), progress=not a.quiet)
     s = summary(run, names)
     (Path(a.out) / "summary.json").write_text(json.dumps(s, indent=1))
     print(f"{'concepts':<28}{s['concepts']}")
@@ -86,5 +88,7 @@ def add_commands(sub) -> None:
     p.add_argument("--iterations", type=int, default=8, help="explore-compress iterations at most")
     p.add_argument("--dataset", help="a built dataset folder (default: build OUT/dataset for these concepts)")
     p.add_argument("--seed", type=int, default=0, help="dataset seed when building (default 0)")
+    p.add_argument("--width", type=int, default=32,
+                   help="concepts searched in lockstep, their programs stepped in shared batches (default 32)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(fn=cmd_induce)

@@ -21,7 +21,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Generator, Sequence
 
 import jax
 import jax.numpy as jnp
@@ -34,7 +34,8 @@ from vccjax.explain import ASK, YES, Target, load_target, verdict
 from vccjax.instructions import NAMES, OP, arg_domain
 from vccjax.program import Program
 from vccjax.scene import Scene, scenes_match
-from vccjax.state import SceneConst, init_state, load_scene, output_scene, stack
+from vccjax.state import (SceneConst, VCCState, init_state, load_scene, output_scene, pack_state, packed_field,
+                          stack, unpack_state)
 
 MAX_PORTIONS = 40
 
@@ -75,20 +76,32 @@ class Result:
     compile_seconds: float = 0.0  # of `seconds`, spent compiling new (op, batch size) steps
 
 
-def _judge(cfg: VCCConfig, consts: SceneConst, targets: Target, states):
-    v = jax.vmap(jax.vmap(functools.partial(verdict, cfg)), in_axes=(None, 0, None))(consts, states, targets)
-    return jnp.any(states.failed, axis=1), v
+def _judge(cfg: VCCConfig, consts: SceneConst, targets: Target, tasks, states: VCCState):
+    def row(task, s):
+        c, t = jax.tree.map(lambda a: a[task], (consts, targets))
+        return jax.vmap(functools.partial(verdict, cfg))(c, s, t)
+
+    return jnp.any(states.failed, axis=1), jax.vmap(row)(tasks, states)
 
 
-judge = jax.jit(_judge, static_argnums=0)
+@functools.partial(jax.jit, static_argnums=0)
+def judge(cfg: VCCConfig, consts: SceneConst, targets: Target, tasks, packed):
+    return _judge(cfg, consts, targets, tasks, unpack_state(packed, cfg))
 
 
-@functools.partial(jax.jit, static_argnums=(0, 1, 6))
-def advance(cfg: VCCConfig, op: int, consts: SceneConst, targets: Target, states, args, replay: bool = True):
-    """Step (B, E) states by `op`; return them, whether each program failed on any
-    example, and its verdict per example."""
-    new = step_examples(cfg, op, consts, states, args, replay)
-    return (new, *_judge(cfg, consts, targets, new))
+@functools.partial(jax.jit, static_argnums=(0, 1, 7))
+def advance(cfg: VCCConfig, op: int, consts: SceneConst, targets: Target, tasks, packed, args,
+            replay: bool = True):
+    """Step (B, E) packed states, each row a program of task `tasks[row]`, by `op`; return
+    them, whether each program failed on any example, and its verdict per example."""
+    new = step_examples(cfg, op, consts, tasks, unpack_state(packed, cfg), args, replay)
+    return (pack_state(new, cfg), *_judge(cfg, consts, targets, tasks, new))
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1))
+def replay(cfg: VCCConfig, op: int, consts: SceneConst, tasks, packed, args, pcs, active):
+    """`replay_examples` on packed states."""
+    return pack_state(replay_examples(cfg, op, consts, tasks, unpack_state(packed, cfg), args, pcs, active), cfg)
 
 
 def _take(tree, idx: np.ndarray):
@@ -112,16 +125,39 @@ class _Frame:
 
 
 class Explorer:
-    """Batched, pruned enumeration over a chain; one instance keeps its compiled steps."""
+    """Batched, pruned enumeration over a chain; one instance keeps its compiled steps.
 
-    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, chunk: int = 1024, slice_size: int = 4096,
-                 buckets: Sequence[int] = (16, 64, 256, 1024, 4096)):
+    `search` explores one concept; `search_many` explores many in lockstep: each
+    concept's depth-first search runs as a coroutine that asks for its next slice of
+    children to be stepped, and one round steps every active concept's slice together,
+    grouped by instruction, so a group holds the programs of many concepts. The
+    concepts' scenes sit in a bank of `width` slots on the device (a fixed shape: each
+    instruction compiles once whatever the number of concepts)."""
+
+    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, chunk: int = 256, slice_size: int = 256,
+                 buckets: Sequence[int] = (16, 64, 256, 1024, 4096), width: int = 32):
         self.cfg = cfg
-        self.chunk = chunk
-        self.slice_size = slice_size
+        self.chunk = chunk  # live prefixes per frame
+        self.slice_size = slice_size  # children stepped per turn (a round of search_many: width x this)
         self.buckets = tuple(sorted(buckets))
+        self.width = width  # concepts explored at once by search_many (bank slots)
         self._compiled: set[tuple] = set()
         self.compile_seconds = 0.0  # first calls of each (op, size): compile time, kept apart
+        self._bank: tuple[SceneConst, Target] | None = None
+        self._slot: dict[int, int] = {}  # id(task) -> bank slot
+
+    # ---- the bank of concepts' scenes ----------------------------------------------------
+    def _load(self, slot: int, task: Task) -> None:
+        """Put a task's scenes and targets in a bank slot (a new bank if the example count
+        differs from the current one's)."""
+        e = task.n_examples
+        if self._bank is None or self._bank[0].n.shape[1] != e:
+            self._bank = jax.tree.map(lambda a: jnp.broadcast_to(a, (self.width,) + a.shape),
+                                      (task.consts, task.targets))
+            self._slot = {}
+        self._bank = jax.tree.map(lambda b, a: b.at[slot].set(a), self._bank, (task.consts, task.targets))
+        self._slot = {k: v for k, v in self._slot.items() if v != slot}
+        self._slot[id(task)] = slot
 
     # ---- device stepping ------------------------------------------------------------
     def _padded(self, key, n: int, call):
@@ -152,39 +188,41 @@ class Explorer:
         holding = (held >= 0).any(axis=1)
         return [part for part in (np.nonzero(holding)[0], np.nonzero(~holding)[0]) if len(part)]
 
-    def _run_group(self, op: int, task: Task, states, args: np.ndarray):
-        parts = self._holding_parts(op, states.held)
+    def _run_group(self, op: int, tids: np.ndarray, states, args: np.ndarray):
+        parts = self._holding_parts(op, packed_field(states, "held", self.cfg))
         if len(parts) == 1:
-            return self._run_part(op, task, states, args)
-        outs = [(idx, self._run_part(op, task, _take(states, idx), args[idx])) for idx in parts]
+            return self._run_part(op, tids, states, args)
+        outs = [(idx, self._run_part(op, tids[idx], _take(states, idx), args[idx])) for idx in parts]
         merged = jax.tree.map(lambda a: np.empty((len(args),) + a.shape[1:], a.dtype), outs[0][1])
         for idx, out in outs:
             jax.tree.map(lambda dst, src: dst.__setitem__(idx, src), merged, out)  # noqa: B023
         return merged
 
-    def _run_part(self, op: int, task: Task, states, args: np.ndarray):
-        e, cfg = task.n_examples, self.cfg
+    def _run_part(self, op: int, tids: np.ndarray, states, args: np.ndarray):
+        cfg, (consts, targets) = self.cfg, self._bank
+        e = states.shape[1]
         loop_end = op == OP["loop_end"]
         new, failed, v = self._padded(
             ("step", op, e), len(args),
-            lambda pad: advance(cfg, op, task.consts, task.targets, _take(states, pad),
+            lambda pad: advance(cfg, op, consts, targets, jnp.asarray(tids[pad]), _take(states, pad),
                                 jnp.asarray(args[pad]), not loop_end))
         if not loop_end:
             return new, failed, v
-        self._replay(task, new)
+        self._replay(tids, new)
         failed, v = self._padded(("judge", e), len(args),
-                                 lambda pad: judge(cfg, task.consts, task.targets, _take(new, pad)))
+                                 lambda pad: judge(cfg, consts, targets, jnp.asarray(tids[pad]), _take(new, pad)))
         return new, failed, v
 
-    def _replay(self, task: Task, states) -> None:
+    def _replay(self, tids: np.ndarray, states) -> None:
         """A closed loop's remaining iterations, one body instruction at a time, each
         group of programs stepped with that instruction's code only (in place)."""
         cfg = self.cfg
-        ops, args = states.body_ops[:, 0], states.body_args[:, 0]
-        length, pc0 = states.body_len[:, 0], states.body_pc0[:, 0]
+        body = unpack_state(states, cfg)  # the body is fixed once the loop is closed
+        ops, args = body.body_ops[:, 0].copy(), body.body_args[:, 0].copy()
+        length, pc0 = body.body_len[:, 0].copy(), body.body_pc0[:, 0].copy()
         iteration = 1
         while True:
-            active = loop_needs_iteration(cfg, states, iteration)  # host arrays: (n, E)
+            active = loop_needs_iteration(cfg, unpack_state(states, cfg), iteration)  # host: (n, E)
             rows_any = active.any(axis=1)
             if not rows_any.any():
                 return
@@ -192,57 +230,80 @@ class Explorer:
                 live = rows_any & (length > j)
                 for op in np.unique(ops[live, j]):
                     group = np.nonzero(live & (ops[:, j] == op))[0]
-                    for part in self._holding_parts(int(op), states.held[group]):
-                        self._replay_rows(task, states, int(op), group[part], args, pc0, active, j)
+                    for part in self._holding_parts(int(op), packed_field(states[group], "held", cfg)):
+                        self._replay_rows(tids, states, int(op), group[part], args, pc0, active, j)
             iteration += 1
 
-    def _replay_rows(self, task: Task, states, op: int, rows: np.ndarray, args, pc0, active, j: int) -> None:
-        cfg, e = self.cfg, task.n_examples
+    def _replay_rows(self, tids, states, op: int, rows: np.ndarray, args, pc0, active, j: int) -> None:
+        cfg, (consts, _) = self.cfg, self._bank
         sub = _take(states, rows)
-        act = active[rows]
+        act, tr = active[rows], tids[rows]
         new = self._padded(
-            ("replay", op, e), len(rows),
-            lambda pad: replay_examples(cfg, op, task.consts, _take(sub, pad), jnp.asarray(args[rows][pad, j]),
-                                        jnp.asarray(pc0[rows][pad] + j), jnp.asarray(act[pad])))
+            ("replay", op, act.shape[1]), len(rows),
+            lambda pad: replay(cfg, op, consts, jnp.asarray(tr[pad]), _take(sub, pad),
+                                        jnp.asarray(args[rows][pad, j]), jnp.asarray(pc0[rows][pad] + j),
+                                        jnp.asarray(act[pad])))
         jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)
 
     # ---- the backend: what the DFS needs from a machine --------------------------------
     def root_states(self, task: Task):
-        e = task.n_examples
-        return jax.tree.map(lambda a: np.broadcast_to(np.asarray(a), (1, e) + a.shape).copy(),
-                            init_state(self.cfg))
+        row = np.asarray(pack_state(init_state(self.cfg), self.cfg))
+        return np.broadcast_to(row, (1, task.n_examples) + row.shape).copy()
 
     def take(self, states, idx: np.ndarray):
         return _take(states, idx)
 
+    def prepare(self, tasks: Sequence[Task]) -> None:
+        """Make room for these tasks (at most `width`) in the bank."""
+        for slot, task in enumerate(tasks):
+            self._load(slot, task)
+
+    def admit(self, task: Task, active: Sequence[Task]) -> None:
+        """A task joins the ones being explored (search_many): it takes a free slot."""
+        used = {self._slot.get(id(t)) for t in active}
+        self._load(next(k for k in range(self.width) if k not in used), task)
+
     def apply(self, chain: Chain, task: Task, states, portions: np.ndarray):
         """Run each child's portion (one or more atoms) from its parent's state; return the
         states, whether each failed on some example, and whether it explains every one."""
-        n = len(portions)
+        return self.apply_many([(chain, task, states, portions)])[0]
+
+    def apply_many(self, requests: Sequence[tuple]) -> list[tuple]:
+        """`apply` for several (chain, task, states, portions) requests at once: their rows
+        are stepped together, one group per instruction across all requests."""
+        sizes = [len(r[3]) for r in requests]
+        owner = np.repeat(np.arange(len(requests)), sizes)
+        states = requests[0][2] if len(requests) == 1 else _concat([r[2] for r in requests])
+        tids = np.array([self._slot[id(requests[i][1])] for i in owner], np.int32)
+        rows_ops = [r[0].ops[z] for r in requests for z in r[3]]
+        rows_args = [r[0].args[z] for r in requests for z in r[3]]
+        n = len(owner)
+        e = states.shape[1]
         failed = np.zeros(n, bool)
-        verdicts = np.zeros((n, task.n_examples), np.int32)
-        lengths = np.array([len(chain.ops[z]) for z in portions])
+        verdicts = np.zeros((n, e), np.int32)
+        lengths = np.array([len(o) for o in rows_ops])
         for k in range(int(lengths.max())):
-            ops = np.array([chain.ops[z][k] if lengths[i] > k else -1 for i, z in enumerate(portions)])
-            args = np.array([chain.args[z][k] if lengths[i] > k else 0 for i, z in enumerate(portions)],
-                            np.int32)
+            ops = np.array([o[k] if lengths[i] > k else -1 for i, o in enumerate(rows_ops)])
+            args = np.array([a[k] if lengths[i] > k else 0 for i, a in enumerate(rows_args)], np.int32)
             for op in np.unique(ops[(ops >= 0) & ~failed]):
                 rows = np.nonzero((ops == op) & ~failed)[0]
-                new, f, v = self._run_group(int(op), task, _take(states, rows), args[rows])
-                jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)
+                new, f, v = self._run_group(int(op), tids[rows], _take(states, rows), args[rows])
+                jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)  # noqa: B023
                 failed[rows] |= f
                 verdicts[rows] = v
         ok = ~failed & np.all(verdicts == YES, axis=1)
         for i in np.nonzero(~failed & ~ok & np.all((verdicts == YES) | (verdicts == ASK), axis=1))[0]:
-            ok[i] = self._settle(task, states, int(i), verdicts[i])
-        return states, failed, ok
+            ok[i] = self._settle(requests[owner[i]][1], states, int(i), verdicts[i])
+        bounds = np.cumsum([0] + sizes)
+        return [(jax.tree.map(lambda x: x[a:b], states), failed[a:b], ok[a:b])  # noqa: B023
+                for a, b in zip(bounds[:-1], bounds[1:])]
 
     def _settle(self, task: Task, states, i: int, v: np.ndarray) -> bool:
         """Rare: two same-looking objects within tau of one target; match on the host."""
         for e, (_, out) in enumerate(task.pairs):
             if v[e] == ASK:
                 c = jax.tree.map(lambda a: a[e], task.consts)
-                s = jax.tree.map(lambda a: a[i, e], states)
+                s = unpack_state(states[i, e], self.cfg)
                 if not scenes_match(output_scene(c, s, self.cfg), out, self.cfg.tau):
                     return False
         return True
@@ -250,8 +311,79 @@ class Explorer:
     # ---- the search -------------------------------------------------------------------
     def search(self, chain: Chain, task: Task, budget: int,
                progress: Callable[[int], None] | None = None) -> Result:
+        """The shortest program under the budget's cutoff that explains every example."""
         t0 = time.perf_counter()
         c0 = self.compile_seconds
+        self.prepare([task])
+        dfs = self._dfs(chain, task, budget, progress)
+        try:
+            request = next(dfs)
+            while True:
+                request = dfs.send(self.apply(*request))
+        except StopIteration as stop:
+            found = stop.value
+        return self._result(chain, budget, found, time.perf_counter() - t0, self.compile_seconds - c0)
+
+    def search_many(self, jobs: Sequence[tuple[Chain, Task]], budget: int,
+                    done: Callable[[int, Result], None]) -> None:
+        """Explore every (chain, task) job, `width` at a time in lockstep; `done(index,
+        result)` is called as each finishes (in finishing order). A job's `seconds` and
+        `compile_seconds` are its share, by rows stepped, of the rounds it took part in."""
+        queue = list(range(len(jobs)))
+        active: dict[int, list] = {}  # job -> [coroutine, pending request, seconds, compile seconds]
+
+        def start(j: int) -> None:
+            chain, task = jobs[j]
+            t0 = time.perf_counter()
+            self.admit(task, [jobs[k][1] for k in active])
+            dfs = self._dfs(chain, task, budget, None)
+            try:
+                active[j] = [dfs, next(dfs), time.perf_counter() - t0, 0.0]
+            except StopIteration as stop:  # nothing under the cutoff to run
+                done(j, self._result(chain, budget, stop.value, time.perf_counter() - t0, 0.0))
+
+        while queue or active:
+            while queue and len(active) < self.width:
+                j = queue.pop(0)
+                if active and jobs[j][1].n_examples != jobs[next(iter(active))][1].n_examples:
+                    queue.insert(0, j)  # another example count: after the current ones finish
+                    break
+                start(j)
+            if not active:
+                continue
+            t0, c0 = time.perf_counter(), self.compile_seconds
+            order = list(active)
+            replies = self.apply_many([active[j][1] for j in order])
+            wall, comp = time.perf_counter() - t0, self.compile_seconds - c0
+            rows = np.array([len(active[j][1][3]) for j in order], float)
+            for j, reply, share in zip(order, replies, rows / rows.sum()):
+                entry = active[j]
+                t1 = time.perf_counter()
+                try:
+                    entry[1] = entry[0].send(reply)
+                    entry[2] += wall * share + time.perf_counter() - t1
+                    entry[3] += comp * share
+                except StopIteration as stop:
+                    del active[j]
+                    seconds = entry[2] + wall * share + time.perf_counter() - t1
+                    done(j, self._result(jobs[j][0], budget, stop.value, seconds, entry[3] + comp * share))
+
+    def _result(self, chain: Chain, budget: int, found, seconds: float, compile_seconds: float) -> Result:
+        best, nodes, programs, b_star, table = found
+        if best is None:
+            return Result(False, None, None, None, None, None, nodes, programs, seconds, b_star, budget,
+                          compile_seconds)
+        portions = [int(x) for x in best[1] if x >= 0]
+        return Result(
+            True, self.program(chain, portions), self.text(chain, portions),
+            chain.program_nats(portions), best[0], int(table[best[0] - 1]) + 1 if best[0] > 0 else 1,
+            nodes, programs, seconds, b_star, budget, compile_seconds,
+        )
+
+    def _dfs(self, chain: Chain, task: Task, budget: int,
+             progress: Callable[[int], None] | None) -> Generator[tuple, tuple, tuple]:
+        """The depth-first search as a coroutine: yields (chain, task, states, portions) to
+        be applied, receives `apply`'s answer; returns (best, nodes, programs, b*, table)."""
         b_star, table = cutoff_for_budget(chain, budget)
         below = int(table[b_star - 1]) if b_star > 0 else 0
         quota = budget - below  # programs of cost exactly b* still allowed
@@ -273,7 +405,7 @@ class Explorer:
             sl = keep[: self.slice_size]
             fr.pos = int(sl[-1]) + 1
             p, zz, cc = parent[sl], z[sl], cost[sl]
-            states, failed, ok = self.apply(chain, task, self.take(fr.states, p), zz)
+            states, failed, ok = yield (chain, task, self.take(fr.states, p), zz)
             nodes += len(sl)
             tok = chain.tok[zz]
             syn = chain.next_syn[tok, fr.syn[p]]
@@ -301,16 +433,7 @@ class Explorer:
                     if len(part):
                         frames.append(_Frame(self.take(states, part), tok[part], syn[part], cc[part],
                                              hist[part], fr.depth + 1))
-        seconds = time.perf_counter() - t0
-        comp = self.compile_seconds - c0
-        if best is None:
-            return Result(False, None, None, None, None, None, nodes, programs, seconds, b_star, budget, comp)
-        portions = [int(x) for x in best[1] if x >= 0]
-        return Result(
-            True, self.program(chain, portions), self.text(chain, portions),
-            chain.program_nats(portions), best[0], int(table[best[0] - 1]) + 1 if best[0] > 0 else 1,
-            nodes, programs, seconds, b_star, budget, comp,
-        )
+        return best, nodes, programs, b_star, table
 
     def _children(self, chain: Chain, fr: _Frame, cutoff: int):
         cost = fr.cost[:, None] + chain.trans_bins[fr.last[:, None], chain.tok[None, :]] + chain.argbins[None, :]

@@ -194,16 +194,22 @@ def induce(
         }))
         done = {r["concept"] for r in run.records if r["iteration"] == it} | set(before)
         todo = [c for c in concepts if c not in done]
-        bar = tqdm(todo, desc=f"iteration {it}", disable=not progress, unit="concept")
-        for c in bar:
-            chain = Chain(vocab, model, argument_logp(settings, c), settings.delta)
-            r = explorer.search(chain, Task.from_pairs(pairs(c, "train")), settings.budget)
+        bar = tqdm(total=len(todo), desc=f"iteration {it}", disable=not progress, unit="concept")
+
+        def done(j: int, r: Result, it: int = it, bar=bar) -> None:
+            c = todo[j]
             test = None
             if r.found:
                 tp = pairs(c, "test")
                 test = (generalization(r.program, tp, DEFAULT_CONFIG.tau), len(tp))
             run.append(_record(c, it, r, test))
+            bar.update()
             bar.set_postfix(found=len(run.found()))
+
+        jobs = [(Chain(vocab, model, argument_logp(settings, c), settings.delta), Task.from_pairs(pairs(c, "train")))
+                for c in todo]
+        explorer.search_many(jobs, settings.budget, done)
+        bar.close()
         n_new = sum(1 for r in run.records if r["iteration"] == it and r["found"])
         log(f"iteration {it}: {n_new} new, {len(run.found())} of {len(set(concepts))} found"
             + (f", model with {len(vocab.bodies)} subroutines" if vocab.bodies else ""))

@@ -23,6 +23,15 @@ class ScalarExplorer(Explorer):
     def take(self, states, idx: np.ndarray):
         return [states[i] for i in idx]
 
+    def prepare(self, tasks) -> None:
+        pass  # no device bank: each machine holds its scene
+
+    def admit(self, task, active) -> None:
+        pass
+
+    def apply_many(self, requests):
+        return [self.apply(*r) for r in requests]
+
     def apply(self, chain: Chain, task: Task, states, portions: np.ndarray):
         out, failed, ok = [], np.zeros(len(portions), bool), np.zeros(len(portions), bool)
         for i, (machines, z) in enumerate(zip(states, portions)):

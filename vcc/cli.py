@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from search import cli as search_cli
+from vcc import bench
 from vccjax import cli as vccjax_cli
 
 
@@ -18,6 +19,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     vccjax_cli.add_commands(sub)
     search_cli.add_commands(sub)
+    bench.add_commands(sub)
     return p
 
 

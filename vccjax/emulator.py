@@ -337,30 +337,43 @@ EMPTY_HANDED = {
 }
 
 
-def _batched(cfg: VCCConfig, op: int, make, consts, states, *rest):
-    """`make(fn)` builds the batched step with `fn` standing in for the op's function;
-    a carry op pays for the carry only when some state in the batch holds an object."""
+def _batched(cfg: VCCConfig, op: int, make, first, states, *rest):
+    """`make(fn)` builds the batched step `(first, states, *rest) -> states` with `fn`
+    standing in for the op's function; a carry op pays for the carry only when some
+    state in the batch holds an object."""
     if op not in EMPTY_HANDED:
-        return make(None)(consts, states, *rest)
-    return jax.lax.cond(jnp.any(states.held >= 0), make(None), make(EMPTY_HANDED[op]), consts, states, *rest)
+        return make(None)(first, states, *rest)
+    return jax.lax.cond(jnp.any(states.held >= 0), make(None), make(EMPTY_HANDED[op]), first, states, *rest)
 
 
-@functools.partial(jax.jit, static_argnums=(0, 1, 5))
-def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, args: jax.Array,
-                  replay: bool = True) -> VCCState:
-    """Step B programs' states on the same E examples by one static op.
+def _per_task(consts: SceneConst, one, example_axes: tuple):
+    """Rows of (B, E) states, each row a program of the task `tasks[row]`; `one` steps one
+    (scene, state, ...) pair. The task's scenes are read by index, not copied per row."""
 
-    consts: (E, ...) the examples' scenes; states: (B, E, ...); args: (B,). The scenes
-    are shared, not copied per program: this is the layout the search steps in.
-    With replay=False a `loop_end` only closes the loop: the caller replays the body
-    with `loop_iterations_left` and `replay_examples` (one static op at a time, instead
+    def row(task, s, *rest):
+        c = jax.tree.map(lambda a: a[task], consts)
+        return jax.vmap(one, in_axes=(0, 0) + example_axes)(c, s, *rest)
+
+    return jax.vmap(row)
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1, 6))
+def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Array, states: VCCState,
+                  args: jax.Array, replay: bool = True) -> VCCState:
+    """Step B programs' states on their tasks' E examples by one static op.
+
+    consts: (K, E, ...) the examples' scenes of K tasks (concepts); tasks: (B,) which task
+    each program belongs to; states: (B, E, ...); args: (B,). Programs of many concepts
+    step in one call, so a search over many concepts makes large batches. With
+    replay=False a `loop_end` only closes the loop: the caller replays the body
+    with `loop_needs_iteration` and `replay_examples` (one static op at a time, instead
     of every instruction's code in a traced loop)."""
 
     def per_program(fn):
         one = functools.partial(step_op, cfg, op, fn=fn, replay=replay)
-        return jax.vmap(jax.vmap(one, in_axes=(0, 0, None)), in_axes=(None, 0, 0))
+        return _per_task(consts, one, (None,))
 
-    return _batched(cfg, op, per_program, consts, states, args)
+    return _batched(cfg, op, per_program, tasks, states, args)
 
 
 def loop_needs_iteration(cfg: VCCConfig, s: VCCState, iteration) -> jax.Array:
@@ -370,18 +383,19 @@ def loop_needs_iteration(cfg: VCCConfig, s: VCCState, iteration) -> jax.Array:
 
 
 @functools.partial(jax.jit, static_argnums=(0, 1))
-def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, states: VCCState, args: jax.Array,
-                    pcs: jax.Array, active: jax.Array) -> VCCState:
+def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Array, states: VCCState,
+                    args: jax.Array, pcs: jax.Array, active: jax.Array) -> VCCState:
     """One body instruction of a replayed loop, static op, for states where `active`
-    (B, E); the others are returned unchanged. args, pcs: (B,)."""
+    (B, E); the others are returned unchanged. consts, tasks as in `step_examples`;
+    args, pcs: (B,)."""
 
     def per_program(fn):
         def one(c, s, arg, pc, act):
             return _select(act & ~s.failed, _execute(cfg, op, c, s, arg, pc, fn), s)
 
-        return jax.vmap(jax.vmap(one, in_axes=(0, 0, None, None, 0)), in_axes=(None, 0, 0, 0, 0))
+        return _per_task(consts, one, (None, None, 0))
 
-    return _batched(cfg, op, per_program, consts, states, args, pcs, active)
+    return _batched(cfg, op, per_program, tasks, states, args, pcs, active)
 
 
 def _run(cfg, c, ops, args):

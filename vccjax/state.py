@@ -8,6 +8,9 @@ load-time mask (two column runs per row) shifted by its whole-pixel offset.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -179,3 +182,46 @@ def imagined_mask(s: VCCState, cfg: VCCConfig) -> jax.Array:
 def grid15(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
     """(N, 2) cells of the 15x15 grid (cell = floor(position * 14)) of the object centres."""
     return (centres(c, s, cfg) * 14) // cfg.units
+
+
+# ---- packed states: one int32 row per state, for hosts that hold many of them --------
+@functools.lru_cache(maxsize=None)
+def _layout(cfg: VCCConfig) -> tuple[tuple[tuple[str, tuple, bool, int, int], ...], int]:
+    """(field, shape, is_bool, start, stop) of each VCCState field in a packed row."""
+    s, out, pos = init_state(cfg), [], 0
+    for f in dataclasses.fields(VCCState):
+        a = getattr(s, f.name)
+        size = int(np.prod(a.shape, dtype=int))
+        out.append((f.name, tuple(a.shape), a.dtype == jnp.bool_, pos, pos + size))
+        pos += size
+    return tuple(out), pos
+
+
+def pack_state(s: VCCState, cfg: VCCConfig = DEFAULT_CONFIG) -> jax.Array:
+    """A (batched) state as one int32 array (..., P). A search holds many states on the
+    host; one array per batch instead of one per field keeps its copies and transfers cheap."""
+    layout, _ = _layout(cfg)
+    batch = s.failed.shape
+    parts = [getattr(s, name).reshape(batch + (stop - start,)) for name, _, _, start, stop in layout]
+    xp = np if isinstance(s.failed, np.ndarray) else jnp
+    return xp.concatenate([p.astype(xp.int32) for p in parts], axis=-1)
+
+
+def unpack_state(p, cfg: VCCConfig = DEFAULT_CONFIG) -> VCCState:
+    """`pack_state` undone; on a NumPy array the int fields are views, not copies."""
+    layout, _ = _layout(cfg)
+    batch = p.shape[:-1]
+    fields = {}
+    for name, shape, is_bool, start, stop in layout:
+        a = p[..., start:stop].reshape(batch + shape)
+        fields[name] = a.astype(bool) if is_bool else a
+    return VCCState(**fields)
+
+
+def packed_field(p: np.ndarray, name: str, cfg: VCCConfig = DEFAULT_CONFIG) -> np.ndarray:
+    """One field of packed states, without unpacking the rest."""
+    for field, shape, is_bool, start, stop in _layout(cfg)[0]:
+        if field == name:
+            a = p[..., start:stop].reshape(p.shape[:-1] + shape)
+            return a.astype(bool) if is_bool else a
+    raise KeyError(name)
