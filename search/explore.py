@@ -34,8 +34,8 @@ from vccjax.explain import ASK, YES, Target, load_target, verdict
 from vccjax.instructions import NAMES, OP, arg_domain
 from vccjax.program import Program
 from vccjax.scene import Scene, scenes_match
-from vccjax.state import (SceneConst, VCCState, init_state, load_scene, output_scene, pack_state, packed_field,
-                          stack, unpack_state)
+from vccjax.state import (SceneConst, init_state, load_scene, output_scene, pack_state, packed_field, stack,
+                          unpack_state)
 
 MAX_PORTIONS = 40
 
@@ -76,26 +76,22 @@ class Result:
     compile_seconds: float = 0.0  # of `seconds`, spent compiling new (op, batch size) steps
 
 
-def _judge(cfg: VCCConfig, consts: SceneConst, targets: Target, tasks, states: VCCState):
+@functools.partial(jax.jit, static_argnums=0)
+def judge(cfg: VCCConfig, consts: SceneConst, targets: Target, tasks, packed):
+    """Verdicts (B, E) of packed states, row b against task `tasks[b]`'s outputs."""
     def row(task, s):
         c, t = jax.tree.map(lambda a: a[task], (consts, targets))
         return jax.vmap(functools.partial(verdict, cfg))(c, s, t)
 
-    return jnp.any(states.failed, axis=1), jax.vmap(row)(tasks, states)
+    return jax.vmap(row)(tasks, unpack_state(packed, cfg))
 
 
-@functools.partial(jax.jit, static_argnums=0)
-def judge(cfg: VCCConfig, consts: SceneConst, targets: Target, tasks, packed):
-    return _judge(cfg, consts, targets, tasks, unpack_state(packed, cfg))
-
-
-@functools.partial(jax.jit, static_argnums=(0, 1, 7))
-def advance(cfg: VCCConfig, op: int, consts: SceneConst, targets: Target, tasks, packed, args,
-            replay: bool = True):
+@functools.partial(jax.jit, static_argnums=(0, 1, 6))
+def advance(cfg: VCCConfig, op: int, consts: SceneConst, tasks, packed, args, replay: bool = True):
     """Step (B, E) packed states, each row a program of task `tasks[row]`, by `op`; return
-    them, whether each program failed on any example, and its verdict per example."""
+    them and whether each program failed on any example."""
     new = step_examples(cfg, op, consts, tasks, unpack_state(packed, cfg), args, replay)
-    return (pack_state(new, cfg), *_judge(cfg, consts, targets, tasks, new))
+    return pack_state(new, cfg), jnp.any(new.failed, axis=1)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 1))
@@ -199,19 +195,16 @@ class Explorer:
         return merged
 
     def _run_part(self, op: int, tids: np.ndarray, states, args: np.ndarray):
-        cfg, (consts, targets) = self.cfg, self._bank
-        e = states.shape[1]
+        cfg, (consts, _) = self.cfg, self._bank
         loop_end = op == OP["loop_end"]
-        new, failed, v = self._padded(
-            ("step", op, e), len(args),
-            lambda pad: advance(cfg, op, consts, targets, jnp.asarray(tids[pad]), _take(states, pad),
+        new, failed = self._padded(
+            ("step", op, states.shape[1]), len(args),
+            lambda pad: advance(cfg, op, consts, jnp.asarray(tids[pad]), _take(states, pad),
                                 jnp.asarray(args[pad]), not loop_end))
         if not loop_end:
-            return new, failed, v
+            return new, failed
         self._replay(tids, new)
-        failed, v = self._padded(("judge", e), len(args),
-                                 lambda pad: judge(cfg, consts, targets, jnp.asarray(tids[pad]), _take(new, pad)))
-        return new, failed, v
+        return new, packed_field(new, "failed", cfg).any(axis=1)
 
     def _replay(self, tids: np.ndarray, states) -> None:
         """A closed loop's remaining iterations, one body instruction at a time, each
@@ -263,14 +256,16 @@ class Explorer:
         used = {self._slot.get(id(t)) for t in active}
         self._load(next(k for k in range(self.width) if k not in used), task)
 
-    def apply(self, chain: Chain, task: Task, states, portions: np.ndarray):
+    def apply(self, chain: Chain, task: Task, states, portions: np.ndarray, may_end: np.ndarray):
         """Run each child's portion (one or more atoms) from its parent's state; return the
-        states, whether each failed on some example, and whether it explains every one."""
-        return self.apply_many([(chain, task, states, portions)])[0]
+        states, whether each failed on some example, and, for children that `may_end` (a
+        complete program under the cutoff), whether it explains every example."""
+        return self.apply_many([(chain, task, states, portions, may_end)])[0]
 
     def apply_many(self, requests: Sequence[tuple]) -> list[tuple]:
-        """`apply` for several (chain, task, states, portions) requests at once: their rows
-        are stepped together, one group per instruction across all requests."""
+        """`apply` for several (chain, task, states, portions, may_end) requests at once:
+        their rows are stepped together, one group per instruction across all requests,
+        and the rows that may end are judged together."""
         sizes = [len(r[3]) for r in requests]
         owner = np.repeat(np.arange(len(requests)), sizes)
         states = requests[0][2] if len(requests) == 1 else _concat([r[2] for r in requests])
@@ -280,23 +275,27 @@ class Explorer:
         n = len(owner)
         e = states.shape[1]
         failed = np.zeros(n, bool)
-        verdicts = np.zeros((n, e), np.int32)
         lengths = np.array([len(o) for o in rows_ops])
         for k in range(int(lengths.max())):
             ops = np.array([o[k] if lengths[i] > k else -1 for i, o in enumerate(rows_ops)])
             args = np.array([a[k] if lengths[i] > k else 0 for i, a in enumerate(rows_args)], np.int32)
             for op in np.unique(ops[(ops >= 0) & ~failed]):
                 rows = np.nonzero((ops == op) & ~failed)[0]
-                new, f, v = self._run_group(int(op), tids[rows], _take(states, rows), args[rows])
-                jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)  # noqa: B023
+                new, f = self._run_group(int(op), tids[rows], _take(states, rows), args[rows])
+                states[rows] = new
                 failed[rows] |= f
-                verdicts[rows] = v
+        verdicts = np.zeros((n, e), np.int32)
+        judged = np.nonzero(np.concatenate([r[4] for r in requests]) & ~failed)[0]
+        if len(judged):
+            cfg, (consts, targets) = self.cfg, self._bank
+            verdicts[judged] = self._padded(
+                ("judge", e), len(judged),
+                lambda pad: judge(cfg, consts, targets, jnp.asarray(tids[judged][pad]), states[judged][pad]))
         ok = ~failed & np.all(verdicts == YES, axis=1)
         for i in np.nonzero(~failed & ~ok & np.all((verdicts == YES) | (verdicts == ASK), axis=1))[0]:
             ok[i] = self._settle(requests[owner[i]][1], states, int(i), verdicts[i])
         bounds = np.cumsum([0] + sizes)
-        return [(jax.tree.map(lambda x: x[a:b], states), failed[a:b], ok[a:b])  # noqa: B023
-                for a, b in zip(bounds[:-1], bounds[1:])]
+        return [(states[a:b], failed[a:b], ok[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
 
     def _settle(self, task: Task, states, i: int, v: np.ndarray) -> bool:
         """Rare: two same-looking objects within tau of one target; match on the host."""
@@ -382,7 +381,7 @@ class Explorer:
 
     def _dfs(self, chain: Chain, task: Task, budget: int,
              progress: Callable[[int], None] | None) -> Generator[tuple, tuple, tuple]:
-        """The depth-first search as a coroutine: yields (chain, task, states, portions) to
+        """The depth-first search as a coroutine: yields (chain, task, states, portions, may_end) to
         be applied, receives `apply`'s answer; returns (best, nodes, programs, b*, table)."""
         b_star, table = cutoff_for_budget(chain, budget)
         below = int(table[b_star - 1]) if b_star > 0 else 0
@@ -405,15 +404,16 @@ class Explorer:
             sl = keep[: self.slice_size]
             fr.pos = int(sl[-1]) + 1
             p, zz, cc = parent[sl], z[sl], cost[sl]
-            states, failed, ok = yield (chain, task, self.take(fr.states, p), zz)
-            nodes += len(sl)
             tok = chain.tok[zz]
             syn = chain.next_syn[tok, fr.syn[p]]
+            total = cc + end_bins[tok]
+            may_end = (syn == OUTSIDE) & (total <= cutoff)
+            states, failed, ok = yield (chain, task, self.take(fr.states, p), zz, may_end)
+            nodes += len(sl)
             hist = fr.hist[p].copy()
             if fr.depth < MAX_PORTIONS:
                 hist[:, fr.depth] = zz
-            total = cc + end_bins[tok]
-            complete = ~failed & (syn == OUTSIDE) & (total <= cutoff)
+            complete = ~failed & may_end
             for i in np.nonzero(complete)[0]:
                 if total[i] == b_star:
                     if quota <= 0:

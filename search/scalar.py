@@ -32,7 +32,7 @@ class ScalarExplorer(Explorer):
     def apply_many(self, requests):
         return [self.apply(*r) for r in requests]
 
-    def apply(self, chain: Chain, task: Task, states, portions: np.ndarray):
+    def apply(self, chain: Chain, task: Task, states, portions: np.ndarray, may_end: np.ndarray):
         out, failed, ok = [], np.zeros(len(portions), bool), np.zeros(len(portions), bool)
         for i, (machines, z) in enumerate(zip(states, portions)):
             kids = []
@@ -45,7 +45,7 @@ class ScalarExplorer(Explorer):
                     failed[i] = True
                     break
             out.append(kids)
-            if not failed[i]:
+            if not failed[i] and may_end[i]:
                 ok[i] = all(scenes_match(k.output_scene(), b, self.cfg.tau)
                             for k, (_, b) in zip(kids, task.pairs))
         return out, failed, ok
