@@ -199,10 +199,9 @@ def cutoff_for_budget(chain: Chain, budget: int) -> tuple[int, np.ndarray]:
     The table depends only on the model's transition costs, the syntax and how many
     portions each token has at each argument cost, so concepts whose argument
     distributions differ only in which values they favour share it (cached)."""
+    classes, mult = np.unique(chain.tok.astype(np.int64) * (1 << 32) + chain.argbins, return_counts=True)
     key = hashlib.sha256(b"".join(np.ascontiguousarray(a).tobytes() for a in (
-        np.array([budget, chain.end]), chain.trans_bins, chain.next_syn,
-        np.unique(chain.tok.astype(np.int64) * (1 << 32) + chain.argbins, return_counts=True)[1],
-        np.unique(chain.tok.astype(np.int64) * (1 << 32) + chain.argbins)))).digest()
+        np.array([budget, chain.end]), chain.trans_bins, chain.next_syn, classes, mult))).digest()
     if key not in _TABLES:
         if len(_TABLES) > 256:
             _TABLES.clear()

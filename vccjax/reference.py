@@ -121,10 +121,9 @@ class RefMachine:
         o = self.objects[i]
         return o.x, o.y
 
-    def pixels(self, i: int, dx: int = 0, dy: int = 0) -> set[tuple[int, int]]:
+    def pixels(self, i: int) -> set[tuple[int, int]]:
         o = self.objects[i]
-        s = self.cfg.sub
-        rows, cols = object_pixels(o.shape, o.width, o.x + dx * s, o.y + dy * s, self.cfg)
+        rows, cols = object_pixels(o.shape, o.width, o.x, o.y, self.cfg)
         return set(zip(rows.tolist(), cols.tolist()))
 
     def imagined_set(self) -> set[tuple[int, int]]:

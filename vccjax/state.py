@@ -186,7 +186,7 @@ def grid15(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
 
 # ---- packed states: one int32 row per state, for hosts that hold many of them --------
 @functools.lru_cache(maxsize=None)
-def _layout(cfg: VCCConfig) -> tuple[tuple[tuple[str, tuple, bool, int, int], ...], int]:
+def _layout(cfg: VCCConfig) -> tuple[tuple[str, tuple, bool, int, int], ...]:
     """(field, shape, is_bool, start, stop) of each VCCState field in a packed row."""
     s, out, pos = init_state(cfg), [], 0
     for f in dataclasses.fields(VCCState):
@@ -194,34 +194,31 @@ def _layout(cfg: VCCConfig) -> tuple[tuple[tuple[str, tuple, bool, int, int], ..
         size = int(np.prod(a.shape, dtype=int))
         out.append((f.name, tuple(a.shape), a.dtype == jnp.bool_, pos, pos + size))
         pos += size
-    return tuple(out), pos
+    return tuple(out)
 
 
 def pack_state(s: VCCState, cfg: VCCConfig = DEFAULT_CONFIG) -> jax.Array:
     """A (batched) state as one int32 array (..., P). A search holds many states on the
     host; one array per batch instead of one per field keeps its copies and transfers cheap."""
-    layout, _ = _layout(cfg)
     batch = s.failed.shape
-    parts = [getattr(s, name).reshape(batch + (stop - start,)) for name, _, _, start, stop in layout]
+    parts = [getattr(s, name).reshape(batch + (stop - start,)) for name, _, _, start, stop in _layout(cfg)]
     xp = np if isinstance(s.failed, np.ndarray) else jnp
     return xp.concatenate([p.astype(xp.int32) for p in parts], axis=-1)
 
 
+def _field(p, shape: tuple, is_bool: bool, start: int, stop: int):
+    a = p[..., start:stop].reshape(p.shape[:-1] + shape)
+    return a.astype(bool) if is_bool else a
+
+
 def unpack_state(p, cfg: VCCConfig = DEFAULT_CONFIG) -> VCCState:
     """`pack_state` undone; on a NumPy array the int fields are views, not copies."""
-    layout, _ = _layout(cfg)
-    batch = p.shape[:-1]
-    fields = {}
-    for name, shape, is_bool, start, stop in layout:
-        a = p[..., start:stop].reshape(batch + shape)
-        fields[name] = a.astype(bool) if is_bool else a
-    return VCCState(**fields)
+    return VCCState(**{name: _field(p, *where) for name, *where in _layout(cfg)})
 
 
 def packed_field(p: np.ndarray, name: str, cfg: VCCConfig = DEFAULT_CONFIG) -> np.ndarray:
     """One field of packed states, without unpacking the rest."""
-    for field, shape, is_bool, start, stop in _layout(cfg)[0]:
+    for field, *where in _layout(cfg):
         if field == name:
-            a = p[..., start:stop].reshape(p.shape[:-1] + shape)
-            return a.astype(bool) if is_bool else a
+            return _field(p, *where)
     raise KeyError(name)
