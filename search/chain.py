@@ -87,6 +87,11 @@ class Chain:
                 argbins.append(sum(self._bins(-x[1]) for x in combo))
         self.tok = np.array(tok, np.int32)
         self.ops, self.args = ops, args
+        width = max(len(o) for o in ops)  # the same as tuples and as (portions, atoms) arrays, -1 padded
+        self.op_mat = np.full((len(ops), width), -1, np.int32)
+        self.arg_mat = np.zeros((len(ops), width), np.int32)
+        for z, (o, a) in enumerate(zip(ops, args)):
+            self.op_mat[z, : len(o)], self.arg_mat[z, : len(a)] = o, a
         self.argnats = np.array(argnats)
         self.argbins = np.array(argbins, np.int64)
         lp = self.model.logp

@@ -22,6 +22,7 @@ import dataclasses
 import functools
 import time
 from collections.abc import Callable, Generator, Sequence
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -34,8 +35,8 @@ from vccjax.explain import ASK, YES, Target, load_target, verdict
 from vccjax.instructions import NAMES, OP, arg_domain
 from vccjax.program import Program
 from vccjax.scene import Scene, scenes_match
-from vccjax.state import (SceneConst, init_state, load_scene, output_scene, pack_state, packed_field, stack,
-                          unpack_state)
+from vccjax.state import (SceneConst, blackboard_columns, init_state, load_scene, output_scene, pack_state,
+                          packed_field, stack, unpack_blackboard, unpack_state)
 
 MAX_PORTIONS = 40
 
@@ -78,12 +79,13 @@ class Result:
 
 @functools.partial(jax.jit, static_argnums=0)
 def judge(cfg: VCCConfig, consts: SceneConst, targets: Target, tasks, packed):
-    """Verdicts (B, E) of packed states, row b against task `tasks[b]`'s outputs."""
+    """Verdicts (B, E) of packed states (their blackboard columns suffice), row b against
+    task `tasks[b]`'s outputs."""
     def row(task, s):
         c, t = jax.tree.map(lambda a: a[task], (consts, targets))
         return jax.vmap(functools.partial(verdict, cfg))(c, s, t)
 
-    return jax.vmap(row)(tasks, unpack_state(packed, cfg))
+    return jax.vmap(row)(tasks, unpack_blackboard(packed, cfg))
 
 
 @functools.partial(jax.jit, static_argnums=(0, 1, 6))
@@ -100,12 +102,39 @@ def replay(cfg: VCCConfig, op: int, consts: SceneConst, tasks, packed, args, pcs
     return pack_state(replay_examples(cfg, op, consts, tasks, unpack_state(packed, cfg), args, pcs, active), cfg)
 
 
-def _take(tree, idx: np.ndarray):
-    return jax.tree.map(lambda a: a[idx], tree)
+@functools.lru_cache(maxsize=None)
+def _root_row(cfg: VCCConfig) -> np.ndarray:
+    return np.asarray(pack_state(init_state(cfg), cfg))
 
 
-def _concat(trees):
-    return jax.tree.map(lambda *xs: np.concatenate(xs), *trees)
+CALL_ROWS = 8  # a device call's fixed cost, in rows stepped
+
+
+@functools.lru_cache(maxsize=8192)
+def _cover(n: int, buckets: tuple[int, ...]) -> tuple[int, ...]:
+    """The cheapest multiset of buckets holding n rows (n < the largest bucket)."""
+    best = [(0, ())] + [None] * n  # rows -> (cost, pieces)
+    for m in range(1, n + 1):
+        best[m] = min((CALL_ROWS + b + best[max(m - b, 0)][0], (b,) + best[max(m - b, 0)][1]) for b in buckets)
+    return best[n][1]
+
+
+@functools.partial(jax.jit, donate_argnums=0)
+def _put(bank, slot, item):
+    """`item` into slot `slot` of every leaf of `bank` (one compiled update, not one per leaf)."""
+    return jax.tree.map(lambda b, a: b.at[slot].set(a), bank, item)
+
+
+class Request(NamedTuple):
+    """What a concept's search asks the machine to run: each child is its parent's state
+    (`states[parents[i]]`) stepped by one portion; `may_end` marks complete programs to judge."""
+
+    chain: Chain
+    task: Task
+    states: object  # the frame's states (packed array for Explorer)
+    parents: np.ndarray
+    portions: np.ndarray
+    may_end: np.ndarray
 
 
 @dataclasses.dataclass
@@ -151,100 +180,97 @@ class Explorer:
             self._bank = jax.tree.map(lambda a: jnp.broadcast_to(a, (self.width,) + a.shape),
                                       (task.consts, task.targets))
             self._slot = {}
-        self._bank = jax.tree.map(lambda b, a: b.at[slot].set(a), self._bank, (task.consts, task.targets))
+        self._bank = _put(self._bank, slot, (task.consts, task.targets))
         self._slot = {k: v for k, v in self._slot.items() if v != slot}
         self._slot[id(task)] = slot
 
     # ---- device stepping ------------------------------------------------------------
-    def _padded(self, key, n: int, call):
-        """Run `call(idx)` over 0..n-1 in bucket-sized pieces (the last piece padded by
-        repeating its first row); time first calls of a (key, size) as compile time."""
-        outs, start = [], 0
-        while start < n:
-            size = next((b for b in self.buckets if b >= n - start), self.buckets[-1])
-            take = min(size, n - start)
-            idx = np.arange(start, start + take)
-            pad = np.concatenate([idx, np.full(size - take, idx[0])])
+    def _pieces_of(self, key, rows: np.ndarray, call):
+        """Run `call(idx)` over `rows` in bucket-sized pieces (each padded by repeating its
+        first row), yielding (rows of the piece, outputs without the padding); first calls of
+        a (key, size) are timed as compile time."""
+        start = 0
+        for size in self._pieces(len(rows)):
+            idx = rows[start : start + size]
+            pad = np.concatenate([idx, np.full(size - len(idx), idx[0])])
             first = (key, size) not in self._compiled
             t0 = time.perf_counter()
-            out = jax.tree.map(lambda a: np.asarray(a)[:take], call(pad))
+            out = jax.tree.map(lambda a: np.asarray(a)[: len(idx)], call(pad))  # noqa: B023
             if first:
                 self._compiled.add((key, size))
                 self.compile_seconds += time.perf_counter() - t0
-            outs.append(out)
-            start += take
-        return _concat(outs)
+            yield idx, out
+            start += size
 
-    @staticmethod
-    def _holding_parts(op: int, held: np.ndarray) -> list[np.ndarray]:
-        """Rows of a group split into those where some example holds an object and the
-        rest, for a carry op (the rest then skip the carry: `emulator.EMPTY_HANDED`)."""
+    def _pieces(self, n: int) -> list[int]:
+        """Bucket sizes covering n rows at the least cost, counting each call as
+        CALL_ROWS rows of fixed overhead plus its padded rows (one 1024 call for 300 rows
+        wastes more than a 256 and a 64 cost)."""
+        big = self.buckets[-1]
+        full, rest = divmod(n, big)
+        return [big] * full + (list(_cover(rest, self.buckets)) if rest else [])
+
+    def _holding_parts(self, op: int, states, rows: np.ndarray) -> list[np.ndarray]:
+        """`rows` split into those where some example holds an object and the rest, for a
+        carry op (the rest then skip the carry: `emulator.EMPTY_HANDED`)."""
         if op not in EMPTY_HANDED:
-            return [np.arange(len(held))]
-        holding = (held >= 0).any(axis=1)
-        return [part for part in (np.nonzero(holding)[0], np.nonzero(~holding)[0]) if len(part)]
+            return [rows]
+        holding = (packed_field(states[rows], "held", self.cfg) >= 0).any(axis=1)
+        return [part for part in (rows[holding], rows[~holding]) if len(part)]
 
-    def _run_group(self, op: int, tids: np.ndarray, states, args: np.ndarray):
-        parts = self._holding_parts(op, packed_field(states, "held", self.cfg))
-        if len(parts) == 1:
-            return self._run_part(op, tids, states, args)
-        outs = [(idx, self._run_part(op, tids[idx], _take(states, idx), args[idx])) for idx in parts]
-        merged = jax.tree.map(lambda a: np.empty((len(args),) + a.shape[1:], a.dtype), outs[0][1])
-        for idx, out in outs:
-            jax.tree.map(lambda dst, src: dst.__setitem__(idx, src), merged, out)  # noqa: B023
-        return merged
-
-    def _run_part(self, op: int, tids: np.ndarray, states, args: np.ndarray):
+    def _step_rows(self, op: int, tids: np.ndarray, states, rows: np.ndarray, args: np.ndarray,
+                   failed: np.ndarray) -> None:
+        """Step `states[rows]` (packed, (n, E, P), in place) by `op`; mark the failures."""
         cfg, (consts, _) = self.cfg, self._bank
         loop_end = op == OP["loop_end"]
-        new, failed = self._padded(
-            ("step", op, states.shape[1]), len(args),
-            lambda pad: advance(cfg, op, consts, jnp.asarray(tids[pad]), _take(states, pad),
-                                jnp.asarray(args[pad]), not loop_end))
-        if not loop_end:
-            return new, failed
-        self._replay(tids, new)
-        return new, packed_field(new, "failed", cfg).any(axis=1)
+        for part in self._holding_parts(op, states, rows):
+            for idx, (new, f) in self._pieces_of(
+                    ("step", op, states.shape[1]), part,
+                    lambda pad: advance(cfg, op, consts, tids[pad], states[pad], args[pad], not loop_end)):
+                states[idx] = new
+                failed[idx] |= f
+        if loop_end:
+            self._replay(tids, states, rows)
+            failed[rows] |= packed_field(states[rows], "failed", cfg).any(axis=1)
 
-    def _replay(self, tids: np.ndarray, states) -> None:
-        """A closed loop's remaining iterations, one body instruction at a time, each
-        group of programs stepped with that instruction's code only (in place)."""
+    def _replay(self, tids: np.ndarray, states, rows: np.ndarray) -> None:
+        """A closed loop's remaining iterations for `states[rows]`, one body instruction at a
+        time, each group of programs stepped with that instruction's code only (in place)."""
         cfg = self.cfg
-        body = unpack_state(states, cfg)  # the body is fixed once the loop is closed
-        ops, args = body.body_ops[:, 0].copy(), body.body_args[:, 0].copy()
-        length, pc0 = body.body_len[:, 0].copy(), body.body_pc0[:, 0].copy()
+        body = unpack_state(states[rows], cfg)  # the body is fixed once the loop is closed
+        ops, args = body.body_ops[:, 0], body.body_args[:, 0]
+        length, pc0 = body.body_len[:, 0], body.body_pc0[:, 0]
+        active = np.zeros(states.shape[:2], bool)  # (all rows, E)
         iteration = 1
         while True:
-            active = loop_needs_iteration(cfg, unpack_state(states, cfg), iteration)  # host: (n, E)
-            rows_any = active.any(axis=1)
+            active[rows] = loop_needs_iteration(cfg, unpack_state(states[rows], cfg), iteration)  # host
+            rows_any = active[rows].any(axis=1)
             if not rows_any.any():
                 return
             for j in range(int(length[rows_any].max())):
                 live = rows_any & (length > j)
                 for op in np.unique(ops[live, j]):
-                    group = np.nonzero(live & (ops[:, j] == op))[0]
-                    for part in self._holding_parts(int(op), packed_field(states[group], "held", cfg)):
-                        self._replay_rows(tids, states, int(op), group[part], args, pc0, active, j)
+                    local = np.nonzero(live & (ops[:, j] == op))[0]
+                    arg_j, pc_j = np.zeros(len(states), np.int32), np.zeros(len(states), np.int32)
+                    arg_j[rows[local]], pc_j[rows[local]] = args[local, j], pc0[local] + j
+                    for part in self._holding_parts(int(op), states, rows[local]):
+                        self._replay_rows(tids, states, int(op), part, arg_j, pc_j, active)
             iteration += 1
 
-    def _replay_rows(self, tids, states, op: int, rows: np.ndarray, args, pc0, active, j: int) -> None:
+    def _replay_rows(self, tids, states, op: int, rows: np.ndarray, args, pcs, active) -> None:
         cfg, (consts, _) = self.cfg, self._bank
-        sub = _take(states, rows)
-        act, tr = active[rows], tids[rows]
-        new = self._padded(
-            ("replay", op, act.shape[1]), len(rows),
-            lambda pad: replay(cfg, op, consts, jnp.asarray(tr[pad]), _take(sub, pad),
-                                        jnp.asarray(args[rows][pad, j]), jnp.asarray(pc0[rows][pad] + j),
-                                        jnp.asarray(act[pad])))
-        jax.tree.map(lambda dst, src: dst.__setitem__(rows, src), states, new)
+        for idx, new in self._pieces_of(
+                ("replay", op, active.shape[1]), rows,
+                lambda pad: replay(cfg, op, consts, tids[pad], states[pad], args[pad], pcs[pad], active[pad])):
+            states[idx] = new
 
     # ---- the backend: what the DFS needs from a machine --------------------------------
     def root_states(self, task: Task):
-        row = np.asarray(pack_state(init_state(self.cfg), self.cfg))
+        row = _root_row(self.cfg)
         return np.broadcast_to(row, (1, task.n_examples) + row.shape).copy()
 
     def take(self, states, idx: np.ndarray):
-        return _take(states, idx)
+        return states[idx]
 
     def prepare(self, tasks: Sequence[Task]) -> None:
         """Make room for these tasks (at most `width`) in the bank."""
@@ -256,45 +282,45 @@ class Explorer:
         used = {self._slot.get(id(t)) for t in active}
         self._load(next(k for k in range(self.width) if k not in used), task)
 
-    def apply(self, chain: Chain, task: Task, states, portions: np.ndarray, may_end: np.ndarray):
+    def apply(self, request: Request):
         """Run each child's portion (one or more atoms) from its parent's state; return the
-        states, whether each failed on some example, and, for children that `may_end` (a
+        states, whether each failed on some example, and, for children that may end (a
         complete program under the cutoff), whether it explains every example."""
-        return self.apply_many([(chain, task, states, portions, may_end)])[0]
+        return self.apply_many([request])[0]
 
-    def apply_many(self, requests: Sequence[tuple]) -> list[tuple]:
-        """`apply` for several (chain, task, states, portions, may_end) requests at once:
-        their rows are stepped together, one group per instruction across all requests,
-        and the rows that may end are judged together."""
-        sizes = [len(r[3]) for r in requests]
+    def apply_many(self, requests: Sequence[Request]) -> list[tuple]:
+        """`apply` for several requests at once: their rows are stepped together, one group
+        per instruction across all requests, and the rows that may end are judged together."""
+        sizes = [len(r.portions) for r in requests]
+        bounds = np.cumsum([0] + sizes)
         owner = np.repeat(np.arange(len(requests)), sizes)
-        states = requests[0][2] if len(requests) == 1 else _concat([r[2] for r in requests])
-        tids = np.array([self._slot[id(requests[i][1])] for i in owner], np.int32)
-        rows_ops = [r[0].ops[z] for r in requests for z in r[3]]
-        rows_args = [r[0].args[z] for r in requests for z in r[3]]
+        first = requests[0].states
+        states = np.empty((bounds[-1],) + first.shape[1:], first.dtype)
+        for r, a, b in zip(requests, bounds[:-1], bounds[1:]):
+            np.take(r.states, r.parents, axis=0, out=states[a:b])  # one copy: parents to the batch
+        tids = np.array([self._slot[id(r.task)] for r in requests], np.int32)[owner]
+        width = max(r.chain.op_mat.shape[1] for r in requests)
+        pad = lambda m: np.pad(m, ((0, 0), (0, width - m.shape[1])), constant_values=-1)  # noqa: E731
+        op_rows = np.concatenate([pad(r.chain.op_mat[r.portions]) for r in requests])  # (n, atoms), -1 padded
+        arg_rows = np.maximum(np.concatenate([pad(r.chain.arg_mat[r.portions]) for r in requests]), 0)
         n = len(owner)
         e = states.shape[1]
         failed = np.zeros(n, bool)
-        lengths = np.array([len(o) for o in rows_ops])
-        for k in range(int(lengths.max())):
-            ops = np.array([o[k] if lengths[i] > k else -1 for i, o in enumerate(rows_ops)])
-            args = np.array([a[k] if lengths[i] > k else 0 for i, a in enumerate(rows_args)], np.int32)
+        for k in range(width):
+            ops, args = op_rows[:, k], np.ascontiguousarray(arg_rows[:, k])
             for op in np.unique(ops[(ops >= 0) & ~failed]):
-                rows = np.nonzero((ops == op) & ~failed)[0]
-                new, f = self._run_group(int(op), tids[rows], _take(states, rows), args[rows])
-                states[rows] = new
-                failed[rows] |= f
+                self._step_rows(int(op), tids, states, np.nonzero((ops == op) & ~failed)[0], args, failed)
         verdicts = np.zeros((n, e), np.int32)
-        judged = np.nonzero(np.concatenate([r[4] for r in requests]) & ~failed)[0]
+        judged = np.nonzero(np.concatenate([r.may_end for r in requests]) & ~failed)[0]
         if len(judged):
             cfg, (consts, targets) = self.cfg, self._bank
-            verdicts[judged] = self._padded(
-                ("judge", e), len(judged),
-                lambda pad: judge(cfg, consts, targets, jnp.asarray(tids[judged][pad]), states[judged][pad]))
+            boards = states[:, :, : blackboard_columns(cfg)]
+            for idx, v in self._pieces_of(("judge", e), judged,
+                                          lambda pad: judge(cfg, consts, targets, tids[pad], boards[pad])):
+                verdicts[idx] = v
         ok = ~failed & np.all(verdicts == YES, axis=1)
         for i in np.nonzero(~failed & ~ok & np.all((verdicts == YES) | (verdicts == ASK), axis=1))[0]:
-            ok[i] = self._settle(requests[owner[i]][1], states, int(i), verdicts[i])
-        bounds = np.cumsum([0] + sizes)
+            ok[i] = self._settle(requests[owner[i]].task, states, int(i), verdicts[i])
         return [(states[a:b], failed[a:b], ok[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
 
     def _settle(self, task: Task, states, i: int, v: np.ndarray) -> bool:
@@ -318,7 +344,7 @@ class Explorer:
         try:
             request = next(dfs)
             while True:
-                request = dfs.send(self.apply(*request))
+                request = dfs.send(self.apply(request))
         except StopIteration as stop:
             found = stop.value
         return self._result(chain, budget, found, time.perf_counter() - t0, self.compile_seconds - c0)
@@ -354,7 +380,7 @@ class Explorer:
             order = list(active)
             replies = self.apply_many([active[j][1] for j in order])
             wall, comp = time.perf_counter() - t0, self.compile_seconds - c0
-            rows = np.array([len(active[j][1][3]) for j in order], float)
+            rows = np.array([len(active[j][1].portions) for j in order], float)
             for j, reply, share in zip(order, replies, rows / rows.sum()):
                 entry = active[j]
                 t1 = time.perf_counter()
@@ -380,9 +406,9 @@ class Explorer:
         )
 
     def _dfs(self, chain: Chain, task: Task, budget: int,
-             progress: Callable[[int], None] | None) -> Generator[tuple, tuple, tuple]:
-        """The depth-first search as a coroutine: yields (chain, task, states, portions, may_end) to
-        be applied, receives `apply`'s answer; returns (best, nodes, programs, b*, table)."""
+             progress: Callable[[int], None] | None) -> Generator[Request, tuple, tuple]:
+        """The depth-first search as a coroutine: yields a `Request` to be applied, receives
+        `apply`'s answer; returns (best, nodes, programs, b*, table)."""
         b_star, table = cutoff_for_budget(chain, budget)
         below = int(table[b_star - 1]) if b_star > 0 else 0
         quota = budget - below  # programs of cost exactly b* still allowed
@@ -408,7 +434,7 @@ class Explorer:
             syn = chain.next_syn[tok, fr.syn[p]]
             total = cc + end_bins[tok]
             may_end = (syn == OUTSIDE) & (total <= cutoff)
-            states, failed, ok = yield (chain, task, self.take(fr.states, p), zz, may_end)
+            states, failed, ok = yield Request(chain, task, fr.states, p, zz, may_end)
             nodes += len(sl)
             hist = fr.hist[p].copy()
             if fr.depth < MAX_PORTIONS:

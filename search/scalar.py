@@ -10,8 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from search.chain import Chain
-from search.explore import Explorer, Task
+from search.explore import Explorer, Request, Task
 from vccjax.reference import RefMachine
 from vccjax.scene import scenes_match
 
@@ -29,10 +28,12 @@ class ScalarExplorer(Explorer):
     def admit(self, task, active) -> None:
         pass
 
-    def apply_many(self, requests):
-        return [self.apply(*r) for r in requests]
+    def apply_many(self, requests: list[Request]):
+        return [self.apply(r) for r in requests]
 
-    def apply(self, chain: Chain, task: Task, states, portions: np.ndarray, may_end: np.ndarray):
+    def apply(self, request: Request):
+        chain, task, portions, may_end = request.chain, request.task, request.portions, request.may_end
+        states = [request.states[i] for i in request.parents]
         out, failed, ok = [], np.zeros(len(portions), bool), np.zeros(len(portions), bool)
         for i, (machines, z) in enumerate(zip(states, portions)):
             kids = []

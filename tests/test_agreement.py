@@ -149,7 +149,8 @@ def test_no_retracing_across_programs_and_scenes():
 def test_derived_raster_masks_and_grid_match_the_reference_pixels():
     """The full-resolution masks derived from the JAX state are the reference's pixel sets,
     after motion too; the 15x15 grid cell is floor(position * 14)."""
-    from vccjax.state import grid15, imagined_mask, object_masks
+    from vccjax.motion import imagined_mask
+    from vccjax.state import grid15, object_masks
 
     rng = np.random.default_rng(17)
     checked = 0
@@ -174,7 +175,7 @@ def test_derived_raster_masks_and_grid_match_the_reference_pixels():
         imag = np.zeros((CFG.raster, CFG.raster), bool)
         for r, col in ref.imagined_set():
             imag[r, col] = True
-        assert (np.asarray(imagined_mask(st, CFG)) == imag).all()
+        assert (np.asarray(imagined_mask(st.imag_kind, st.imag_pos, CFG)) == imag).all()
         checked += 1
     assert checked >= 20
 

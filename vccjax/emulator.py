@@ -23,7 +23,7 @@ from vccjax import motion
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.instructions import FORBIDDEN_IN_LOOP, N_OPS, NAMES, OP
 from vccjax.program import Program
-from vccjax.state import SceneConst, VCCState, centres, empty_runs, init_state
+from vccjax.state import SceneConst, VCCState, centres, init_state
 
 _FORBIDDEN = np.array([OP[n] for n in sorted(FORBIDDEN_IN_LOOP)], np.int32)
 _NONE = jnp.int32(-1)
@@ -189,16 +189,15 @@ def op_remove_from_imagine_buffer(cfg, c, s, arg):
 
 
 def op_imagine_object(cfg, c, s, arg):
-    runs, cruns = motion.imagined_runs(arg, s.fovea, cfg)
+    runs, _ = motion.imagined_runs(arg, s.fovea, cfg)
     occ = motion.occupancy(c, s, cfg, exclude=_NONE, imagined=False)
     overlap = jnp.any(occ & motion.run_bits(runs[:, 0], runs[:, 1], cfg))
-    s2 = s.replace(imag_kind=jnp.int32(arg), imag_pos=s.fovea, imag_runs=runs, imag_cruns=cruns)
+    s2 = s.replace(imag_kind=jnp.int32(arg), imag_pos=s.fovea)
     return s2, (s.imag_kind >= 0) | overlap
 
 
 def op_reset_imagination(cfg, c, s, arg):
-    empty = empty_runs(cfg)
-    return s.replace(imag_kind=_NONE, imag_runs=empty, imag_cruns=empty), s.imag_kind < 0
+    return s.replace(imag_kind=_NONE), s.imag_kind < 0
 
 
 def op_loop_start(cfg, c, s, arg):
@@ -332,6 +331,7 @@ def _fails_empty_handed(cfg, c, s, arg):
 # when no state in a batch holds one, these ops run a stand-in with the same outcome.
 EMPTY_HANDED = {
     OP["move_hand_to_attended_object"]: functools.partial(_hand_to_attended, carry=False),
+    **{OP[f"move_hand_{d}"]: _fails_empty_handed for d in ("left", "right", "up", "down")},
     OP["move_hand_to_pointer"]: _fails_empty_handed,
     OP["move_hand_to_fixate_collision"]: _fails_empty_handed,
 }

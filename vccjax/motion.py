@@ -68,7 +68,7 @@ def occupancy(
     occ = jnp.zeros((cfg.raster, cfg.words), jnp.uint32)
     occ = occ.at[jnp.clip(lines, 0, cfg.raster - 1)].add(bits)
     if imagined:
-        im = s.imag_runs if axis == 0 else s.imag_cruns
+        im = imagined_runs(s.imag_kind, s.imag_pos, cfg)[axis]
         occ = occ | run_bits(im[:, 0], im[:, 1], cfg)
     return occ
 
@@ -85,9 +85,12 @@ def contains(c: SceneConst, s: VCCState, cfg: VCCConfig, point: jax.Array) -> ja
     return ok & inside
 
 
-def imagined_runs(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> tuple[jax.Array, jax.Array]:
-    """Per-row and per-column runs (R, 2) of an imagined circle (kind 0) or hline (kind 1),
-    with the exact integer tests of geometry.imagined_pixels."""
+def imagined_mask(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> jax.Array:
+    """(R, R) bool footprint (rows, cols) of an imagined circle (kind 0) or hline (kind 1)
+    at `at`, empty for kind -1, with the exact integer tests of geometry.imagined_pixels.
+
+    The state keeps only the kind and position: the footprint is cheap to remake where
+    contact needs it, and 4R fewer integers per state make every batched step cheaper."""
     u, sub, r = cfg.units, cfg.sub, cfg.raster
     centres = jnp.arange(r, dtype=jnp.int32) * sub + sub // 2
     dy = centres - at[1]
@@ -96,7 +99,14 @@ def imagined_runs(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> tuple[jax.A
         kind == 0,
         16 * (dx[None, :] ** 2 + dy[:, None] ** 2) <= u * u,
         jnp.broadcast_to((100 * jnp.abs(dy) <= u)[:, None], (r, r)),
-    )  # (rows, cols)
+    )
+    return fp & (kind >= 0)
+
+
+def imagined_runs(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> tuple[jax.Array, jax.Array]:
+    """Per-row and per-column runs (R, 2) of the imagined footprint (lo > hi: empty)."""
+    r = cfg.raster
+    fp = imagined_mask(kind, at, cfg)
 
     def runs(m):  # each line of m is one run or empty (both footprints are convex)
         any_ = m.any(axis=1)

@@ -45,8 +45,6 @@ class VCCState:
     offset: jax.Array  # (N, 2) whole-pixel displacement since load (x, y)
     imag_kind: jax.Array  # () -1 none, 0 circle, 1 hline
     imag_pos: jax.Array  # (2,)
-    imag_runs: jax.Array  # (R, 2) column run per raster row (lo > hi: empty)
-    imag_cruns: jax.Array  # (R, 2) row run per raster column
     fovea: jax.Array  # (2,)
     hist: jax.Array  # (H, 2) fixation history
     hist_len: jax.Array  # ()
@@ -122,7 +120,7 @@ def init_state(cfg: VCCConfig = DEFAULT_CONFIG) -> VCCState:
     return VCCState(
         parsed=jnp.bool_(False), alive=jnp.zeros(n, bool), color=jnp.zeros(n, i32),
         offset=jnp.zeros((n, 2), i32), imag_kind=i32(-1), imag_pos=jnp.zeros(2, i32),
-        imag_runs=empty_runs(cfg), imag_cruns=empty_runs(cfg), fovea=centre,
+        fovea=centre,
         hist=jnp.zeros((cfg.hist_max, 2), i32).at[0].set(centre), hist_len=i32(1),
         hist_idx=i32(0), hand=centre, held=i32(-1), shape_filter=i32(-1), color_filter=i32(-1),
         attn=jnp.full(n, -1, i32), attn_len=i32(0), stale=jnp.bool_(True), cursor=i32(0),
@@ -131,10 +129,6 @@ def init_state(cfg: VCCConfig = DEFAULT_CONFIG) -> VCCState:
         body_ops=jnp.full(cfg.body_max, -1, i32), body_args=jnp.zeros(cfg.body_max, i32),
         body_len=i32(0), body_pc0=i32(0),
     )
-
-
-def empty_runs(cfg: VCCConfig) -> jax.Array:
-    return jnp.tile(jnp.array([1, 0], jnp.int32), (cfg.raster, 1))
 
 
 def stack(trees):
@@ -171,12 +165,6 @@ def object_masks(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
         (col >= runs[..., 2:3]) & (col <= runs[..., 3:4])
     )
     return inside & valid[:, :, None]
-
-
-def imagined_mask(s: VCCState, cfg: VCCConfig) -> jax.Array:
-    """(R, R) bool footprint of the imagined object (empty if none)."""
-    col = jnp.arange(cfg.raster)[None, :]
-    return (col >= s.imag_runs[:, 0:1]) & (col <= s.imag_runs[:, 1:2])
 
 
 def grid15(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
@@ -222,3 +210,26 @@ def packed_field(p: np.ndarray, name: str, cfg: VCCConfig = DEFAULT_CONFIG) -> n
         if field == name:
             return _field(p, *where)
     raise KeyError(name)
+
+
+@struct.dataclass
+class Blackboard:
+    """What output matching reads of a state: the objects' presence, colours and offsets."""
+
+    alive: jax.Array
+    color: jax.Array
+    offset: jax.Array
+
+
+BLACKBOARD = ("alive", "color", "offset")
+
+
+def blackboard_columns(cfg: VCCConfig = DEFAULT_CONFIG) -> int:
+    """How many leading columns of a packed row hold the blackboard (the layout puts those
+    fields first, so judging outputs moves a small slice of each state, not all of it)."""
+    return max(stop for name, _, _, _, stop in _layout(cfg) if name in BLACKBOARD)
+
+
+def unpack_blackboard(p, cfg: VCCConfig = DEFAULT_CONFIG) -> Blackboard:
+    """The blackboard of packed rows, full or cut to `blackboard_columns`."""
+    return Blackboard(**{name: _field(p, *where) for name, *where in _layout(cfg) if name in BLACKBOARD})
