@@ -27,6 +27,8 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jax.sharding import Mesh, NamedSharding
+from jax.sharding import PartitionSpec as P
 
 from search.chain import NOT_STARTED, OUTSIDE, Chain, cutoff_for_budget
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
@@ -160,8 +162,15 @@ class Explorer:
     instruction compiles once whatever the number of concepts)."""
 
     def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, chunk: int = 256, slice_size: int = 256,
-                 buckets: Sequence[int] = (16, 64, 256, 1024, 4096), width: int = 32):
+                 buckets: Sequence[int] = (16, 64, 256, 1024, 4096), width: int = 32,
+                 devices: Sequence[jax.Device] | None = None):
         self.cfg = cfg
+        # every batch is split by rows over these devices (the bank of scenes is copied to each)
+        self.devices = list(devices) if devices is not None else jax.devices()
+        if any(b % len(self.devices) for b in buckets):
+            raise ValueError(f"batch sizes {tuple(buckets)} must divide over {len(self.devices)} devices")
+        mesh = Mesh(np.array(self.devices), ("rows",))
+        self._rows, self._everywhere = NamedSharding(mesh, P("rows")), NamedSharding(mesh, P())
         self.chunk = chunk  # live prefixes per frame
         self.slice_size = slice_size  # children stepped per turn (a round of search_many: width x this)
         self.buckets = tuple(sorted(buckets))
@@ -177,17 +186,18 @@ class Explorer:
         differs from the current one's)."""
         e = task.n_examples
         if self._bank is None or self._bank[0].n.shape[1] != e:
-            self._bank = jax.tree.map(lambda a: jnp.broadcast_to(a, (self.width,) + a.shape),
-                                      (task.consts, task.targets))
+            self._bank = jax.device_put(jax.tree.map(lambda a: jnp.broadcast_to(a, (self.width,) + a.shape),
+                                                     (task.consts, task.targets)), self._everywhere)
             self._slot = {}
-        self._bank = _put(self._bank, slot, (task.consts, task.targets))
+        self._bank = _put(self._bank, slot, jax.device_put((task.consts, task.targets), self._everywhere))
         self._slot = {k: v for k, v in self._slot.items() if v != slot}
         self._slot[id(task)] = slot
 
     # ---- device stepping ------------------------------------------------------------
     def _pieces_of(self, key, rows: np.ndarray, call):
-        """Run `call(idx)` over `rows` in bucket-sized pieces (each padded by repeating its
-        first row), yielding (rows of the piece, outputs without the padding); first calls of
+        """Run `call(at)` over `rows` in bucket-sized pieces (each padded by repeating its
+        first row; `at(a)` gives a host array's rows of the piece), yielding (rows of the
+        piece, outputs without the padding); first calls of
         a (key, size) are timed as compile time."""
         start = 0
         for size in self._pieces(len(rows)):
@@ -195,12 +205,19 @@ class Explorer:
             pad = np.concatenate([idx, np.full(size - len(idx), idx[0])])
             first = (key, size) not in self._compiled
             t0 = time.perf_counter()
-            out = jax.tree.map(lambda a: np.asarray(a)[: len(idx)], call(pad))  # noqa: B023
+            out = jax.tree.map(lambda a: np.asarray(a)[: len(idx)], call(self._rows_of(pad)))  # noqa: B023
             if first:
                 self._compiled.add((key, size))
                 self.compile_seconds += time.perf_counter() - t0
             yield idx, out
             start += size
+
+    def _rows_of(self, pad: np.ndarray) -> Callable[[np.ndarray], object]:
+        """What `call` gets: `at(a)`, the padded rows of a host array, split over the devices
+        by rows when there are several (XLA then runs each device's share)."""
+        if len(self.devices) == 1:
+            return lambda a: a[pad]
+        return lambda a: jax.device_put(a[pad], self._rows)
 
     def _pieces(self, n: int) -> list[int]:
         """Bucket sizes covering n rows at the least cost, counting each call as
@@ -226,7 +243,7 @@ class Explorer:
         for part in self._holding_parts(op, states, rows):
             for idx, (new, f) in self._pieces_of(
                     ("step", op, states.shape[1]), part,
-                    lambda pad: advance(cfg, op, consts, tids[pad], states[pad], args[pad], not loop_end)):
+                    lambda at: advance(cfg, op, consts, at(tids), at(states), at(args), not loop_end)):
                 states[idx] = new
                 failed[idx] |= f
         if loop_end:
@@ -261,7 +278,7 @@ class Explorer:
         cfg, (consts, _) = self.cfg, self._bank
         for idx, new in self._pieces_of(
                 ("replay", op, active.shape[1]), rows,
-                lambda pad: replay(cfg, op, consts, tids[pad], states[pad], args[pad], pcs[pad], active[pad])):
+                lambda at: replay(cfg, op, consts, at(tids), at(states), at(args), at(pcs), at(active))):
             states[idx] = new
 
     # ---- the backend: what the DFS needs from a machine --------------------------------
@@ -316,7 +333,7 @@ class Explorer:
             cfg, (consts, targets) = self.cfg, self._bank
             boards = states[:, :, : blackboard_columns(cfg)]
             for idx, v in self._pieces_of(("judge", e), judged,
-                                          lambda pad: judge(cfg, consts, targets, tids[pad], boards[pad])):
+                                          lambda at: judge(cfg, consts, targets, at(tids), at(boards))):
                 verdicts[idx] = v
         ok = ~failed & np.all(verdicts == YES, axis=1)
         for i in np.nonzero(~failed & ~ok & np.all((verdicts == YES) | (verdicts == ASK), axis=1))[0]:

@@ -83,6 +83,52 @@ def test_concepts_explored_together_find_what_each_finds_alone(ds):
     assert sum(together[j].found for j in range(len(names))) >= 3
 
 
+_TWO_DEVICES = """
+import json, sys
+import jax
+import numpy as np
+from search.chain import Chain
+from search.explore import Explorer, Task
+from search.induce import Settings, argument_logp
+from search.model import MarkovModel, Vocabulary
+from vccjax.concepts import all_concepts
+from vccjax.dataset import Dataset
+
+folder, concept = sys.argv[1:]
+v = Vocabulary()
+model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], v.size, 1, 0.1)
+chain = Chain(v, model, argument_logp(Settings(args="oracle"), concept))
+ex = Explorer()
+r = ex.search(chain, Task.from_pairs(Dataset(folder).pairs(concept, "train")), 3000)
+spread = ex._rows_of(np.arange(16))(np.arange(16))
+print(json.dumps({"devices": len(ex.devices), "shares": len(spread.sharding.device_set),
+                  "result": [r.text, r.rank, r.nodes, r.programs]}))
+"""
+
+
+def test_batches_split_over_two_devices_give_the_same_search(ds, explorer):
+    """Every batch is split by rows over the JAX devices; with two (forced host devices,
+    in a fresh process) the search is the one a single device makes."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=2")
+    out = subprocess.run([sys.executable, "-c", _TWO_DEVICES, str(ds.folder), LOOP], env=env,
+                         capture_output=True, text=True, timeout=1200)
+    assert out.returncode == 0, out.stderr[-2000:]
+    two = json.loads(out.stdout.strip().splitlines()[-1])
+    assert two["devices"] == 2 and two["shares"] == 2
+    from vccjax.concepts import all_concepts
+
+    v = Vocabulary()
+    model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], v.size, 1, 0.1)
+    one = explorer.search(Chain(v, model, argument_logp(Settings(args="oracle"), LOOP)),
+                          Task.from_pairs(ds.pairs(LOOP, "train")), 3000)
+    assert len(explorer.devices) == 1
+    assert two["result"] == [one.text, one.rank, one.nodes, one.programs]
+
+
 def test_brute_force_finds_the_reference_program_of_a_short_concept(ds, explorer):
     task = Task.from_pairs(ds.pairs("remove_bottom_obj", "train"))
     r = explorer.search(_uniform_chain(), task, 30_000)
