@@ -202,3 +202,25 @@ def test_carry_ops_skip_the_carry_only_when_nothing_is_held(holding):
             ref = RefMachine(sc).run(parse(f"{prefix}; {NAMES[op]}"))
             assert summary_jax(pick(host_b), pick(host_c)) == summary_jax(pick(host_f), pick(host_c))
             assert summary_jax(pick(host_b), pick(host_c)) == summary_ref(ref)
+
+
+def test_imagined_runs_in_closed_form_are_the_footprint_lines():
+    """Contact remakes the imagined object's per-line runs from its kind and position in
+    closed form; they must be exactly the lines of the footprint mask, at any position
+    (off the workspace too) and for no imagined object."""
+    from vccjax.motion import imagined_mask, imagined_runs
+
+    def lines(m):  # first and last pixel of each line (1, 0: empty)
+        any_ = m.any(1)
+        lo, hi = np.argmax(m, 1), CFG.raster - 1 - np.argmax(m[:, ::-1], 1)
+        return np.stack([np.where(any_, lo, 1), np.where(any_, hi, 0)], 1)
+
+    both = jax.jit(jax.vmap(lambda k, a: (imagined_mask(k, a, CFG), imagined_runs(k, a, CFG))))
+    u = CFG.units
+    rng = np.random.default_rng(3)
+    at = np.concatenate([rng.integers(-40, u + 40, (400, 2)), [[0, 0], [u, u], [u // 2, u // 2]]]).astype(np.int32)
+    for kind in (-1, 0, 1):
+        masks, (rows, cols) = jax.tree.map(np.asarray, both(np.full(len(at), kind, np.int32), at))
+        for m, r, c in zip(masks, rows, cols):
+            assert np.array_equal(lines(m), r) and np.array_equal(lines(m.T), c), (kind, m.sum())
+        assert (kind >= 0) == masks.any()

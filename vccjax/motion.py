@@ -103,18 +103,39 @@ def imagined_mask(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> jax.Array:
     return fp & (kind >= 0)
 
 
+def _isqrt(x: jax.Array) -> jax.Array:
+    """floor(sqrt(x)) of int32 x in [0, 2**24): float32 root, corrected by one either way."""
+    d = jnp.floor(jnp.sqrt(x.astype(jnp.float32))).astype(jnp.int32)
+    d = jnp.where(d * d > x, d - 1, d)
+    return jnp.where((d + 1) * (d + 1) <= x, d + 1, d)
+
+
 def imagined_runs(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> tuple[jax.Array, jax.Array]:
-    """Per-row and per-column runs (R, 2) of the imagined footprint (lo > hi: empty)."""
-    r = cfg.raster
-    fp = imagined_mask(kind, at, cfg)
+    """Per-row and per-column runs (R, 2) of the imagined footprint (lo > hi: empty), in
+    closed form: on a line at distance d from the centre, a pixel centre c is inside when
+    |c - centre| <= reach(d) (circle: 16 (dx^2 + dy^2) <= U^2, so reach = isqrt((U^2 -
+    16 d^2) // 16); hline: every pixel of a row within U / 100, so reach = U // 100 down a
+    column). The same pixels as `imagined_mask`, at a fraction of its cost (tested)."""
+    u, sub, r = cfg.units, cfg.sub, cfg.raster
+    centres = jnp.arange(r, dtype=jnp.int32) * sub + sub // 2
+    none = jnp.full(r, -1, jnp.int32)
 
-    def runs(m):  # each line of m is one run or empty (both footprints are convex)
-        any_ = m.any(axis=1)
-        lo = jnp.argmax(m, axis=1)
-        hi = r - 1 - jnp.argmax(m[:, ::-1], axis=1)
-        return jnp.stack([jnp.where(any_, lo, 1), jnp.where(any_, hi, 0)], axis=1).astype(jnp.int32)
+    def disc(d):
+        m = u * u - 16 * d * d
+        return jnp.where(m >= 0, _isqrt(jnp.maximum(m, 0) // 16), -1)
 
-    return runs(fp), runs(fp.T)
+    def around(centre, reach):  # pixels q with |q * sub + sub / 2 - centre| <= reach
+        lo = jnp.maximum(-((sub // 2 + reach - centre) // sub), 0)
+        hi = jnp.minimum((centre + reach - sub // 2) // sub, r - 1)
+        empty = (reach < 0) | (lo > hi)
+        return jnp.stack([jnp.where(empty, 1, lo), jnp.where(empty, 0, hi)], axis=1).astype(jnp.int32)
+
+    dy, dx = centres - at[1], centres - at[0]
+    row_reach = jnp.where(kind == 0, disc(dy), jnp.where(100 * jnp.abs(dy) <= u, 2 * u, -1))
+    col_reach = jnp.where(kind == 0, disc(dx), jnp.full(r, u // 100, jnp.int32))
+    row_reach = jnp.where(kind >= 0, row_reach, none)
+    col_reach = jnp.where(kind >= 0, col_reach, none)
+    return around(at[0], row_reach), around(at[1], col_reach)
 
 
 def _ctz(x: jax.Array) -> jax.Array:
