@@ -184,22 +184,33 @@ def toward_path(start: jax.Array, target: jax.Array, cfg: VCCConfig) -> jax.Arra
 
 
 def carry_toward(c: SceneConst, s: VCCState, cfg: VCCConfig, target: jax.Array) -> VCCState:
-    """Carry the held object toward `target` until contact or arrival, testing every sample."""
+    """Carry the held object toward `target` until contact or arrival, testing every sample.
+
+    The held object's mask is made once as bit words at its current place; at each sample
+    it is shifted as a whole (words moved by d // 32, bits by d % 32) and tested against
+    the K occupancy lines under it, read as one slice of the padded bitmap."""
     i = s.held
-    r = cfg.raster
-    path = toward_path(c.base[i] + s.offset[i] * cfg.sub, target, cfg)
-    occ = occupancy(c, s, cfg, exclude=i)
+    k, w = cfg.mask_rows, cfg.words
+    path = toward_path(c.base[i] + s.offset[i] * cfg.sub, target, cfg)  # (P, 2)
     total = s.offset[i][None, :] + path  # (P, 2) offsets since load
     box = c.box[i]
     out = (
         (total[:, 0] < box[0]) | (total[:, 0] > box[1]) | (total[:, 1] < box[2]) | (total[:, 1] > box[3])
     )
-    rows = c.corner[i, 0] + total[:, 1:2] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
-    occ_rows = occ[jnp.clip(rows, 0, r - 1)]  # (P, K, W)
-    runs = c.runs[i][None] + total[:, 0, None, None]  # (P, K, 4)
-    bits = run_bits(runs[..., 0::2], runs[..., 1::2], cfg)  # (P, K, 2, W)
-    hit = jnp.any((bits & occ_rows[:, :, None, :]) != 0, axis=(1, 2, 3))
-    bad = out | hit
+    lines, lo, hi = _lines(c, s, cfg, 0)
+    mask = jnp.sum(run_bits(lo[i], hi[i], cfg), axis=1, dtype=jnp.uint32)  # (K, W): the two runs are disjoint
+    wide = jnp.pad(mask, ((0, 0), (w + 1, w + 1)))
+    occ = jnp.pad(occupancy(c, s, cfg, exclude=i), ((k, k), (0, 0)))  # rows past the raster: empty
+
+    def hits(d):  # d: whole-pixel shift from here; a sample outside the box is `out` anyway
+        q, b = d[0] // 32, (d[0] % 32).astype(jnp.uint32)
+        here = jax.lax.dynamic_slice(wide, (0, w + 1 - q), (k, w))
+        below = jax.lax.dynamic_slice(wide, (0, w - q), (k, w))
+        moved = jnp.left_shift(here, b) | jnp.right_shift(below, jnp.uint32(32) - b)  # >> 32 is 0
+        under = jax.lax.dynamic_slice(occ, (lines[i, 0] + d[1] + k, 0), (k, w))
+        return jnp.any((moved & under) != 0)
+
+    bad = out | jax.vmap(hits)(path)
     first_bad = jnp.where(bad.any(), jnp.argmax(bad), path.shape[0])
     delta = path[jnp.maximum(first_bad - 1, 0)]
     return s.replace(offset=s.offset.at[i].add(delta), hand=s.hand + delta * cfg.sub)
