@@ -197,8 +197,8 @@ class Explorer:
     def _pieces_of(self, key, rows: np.ndarray, call):
         """Run `call(at)` over `rows` in bucket-sized pieces (each padded by repeating its
         first row; `at(a)` gives a host array's rows of the piece), yielding (rows of the
-        piece, outputs without the padding); first calls of
-        a (key, size) are timed as compile time."""
+        piece, outputs without the padding); first calls of a (key, size) are timed as
+        compile time."""
         start = 0
         for size in self._pieces(len(rows)):
             idx = rows[start : start + size]
