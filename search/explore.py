@@ -232,7 +232,7 @@ class Explorer:
         carry op (the rest then skip the carry: `emulator.EMPTY_HANDED`)."""
         if op not in EMPTY_HANDED:
             return [rows]
-        holding = (packed_field(states[rows], "held", self.cfg) >= 0).any(axis=1)
+        holding = (packed_field(states, "held", self.cfg)[rows] >= 0).any(axis=1)
         return [part for part in (rows[holding], rows[~holding]) if len(part)]
 
     def _step_rows(self, op: int, tids: np.ndarray, states, rows: np.ndarray, args: np.ndarray,
@@ -248,7 +248,7 @@ class Explorer:
                 failed[idx] |= f
         if loop_end:
             self._replay(tids, states, rows)
-            failed[rows] |= packed_field(states[rows], "failed", cfg).any(axis=1)
+            failed[rows] |= packed_field(states, "failed", cfg)[rows].any(axis=1)
 
     def _replay(self, tids: np.ndarray, states, rows: np.ndarray) -> None:
         """A closed loop's remaining iterations for `states[rows]`, one body instruction at a
@@ -258,9 +258,10 @@ class Explorer:
         ops, args = body.body_ops[:, 0], body.body_args[:, 0]
         length, pc0 = body.body_len[:, 0], body.body_pc0[:, 0]
         active = np.zeros(states.shape[:2], bool)  # (all rows, E)
+        arg_j, pc_j = np.zeros(len(states), np.int32), np.zeros(len(states), np.int32)  # read at `rows` only
         iteration = 1
         while True:
-            active[rows] = loop_needs_iteration(cfg, unpack_state(states[rows], cfg), iteration)  # host
+            active[rows] = loop_needs_iteration(cfg, unpack_state(states, cfg), iteration)[rows]  # host
             rows_any = active[rows].any(axis=1)
             if not rows_any.any():
                 return
@@ -268,7 +269,6 @@ class Explorer:
                 live = rows_any & (length > j)
                 for op in np.unique(ops[live, j]):
                     local = np.nonzero(live & (ops[:, j] == op))[0]
-                    arg_j, pc_j = np.zeros(len(states), np.int32), np.zeros(len(states), np.int32)
                     arg_j[rows[local]], pc_j[rows[local]] = args[local, j], pc0[local] + j
                     for part in self._holding_parts(int(op), states, rows[local]):
                         self._replay_rows(tids, states, int(op), part, arg_j, pc_j, active)

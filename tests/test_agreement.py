@@ -149,7 +149,7 @@ def test_no_retracing_across_programs_and_scenes():
 def test_derived_raster_masks_and_grid_match_the_reference_pixels():
     """The full-resolution masks derived from the JAX state are the reference's pixel sets,
     after motion too; the 15x15 grid cell is floor(position * 14)."""
-    from vccjax.motion import imagined_mask
+    from vccjax.motion import imagined_runs
     from vccjax.state import grid15, object_masks
 
     rng = np.random.default_rng(17)
@@ -175,7 +175,7 @@ def test_derived_raster_masks_and_grid_match_the_reference_pixels():
         imag = np.zeros((CFG.raster, CFG.raster), bool)
         for r, col in ref.imagined_set():
             imag[r, col] = True
-        assert (np.asarray(imagined_mask(st.imag_kind, st.imag_pos, CFG)) == imag).all()
+        assert np.array_equal(np.asarray(imagined_runs(st.imag_kind, st.imag_pos, CFG)[0]), _lines(imag))
         checked += 1
     assert checked >= 20
 
@@ -204,23 +204,31 @@ def test_carry_ops_skip_the_carry_only_when_nothing_is_held(holding):
             assert summary_jax(pick(host_b), pick(host_c)) == summary_ref(ref)
 
 
+def _lines(m: np.ndarray) -> np.ndarray:
+    """First and last pixel of each line of a mask (1, 0: an empty line)."""
+    any_ = m.any(1)
+    lo, hi = np.argmax(m, 1), CFG.raster - 1 - np.argmax(m[:, ::-1], 1)
+    return np.stack([np.where(any_, lo, 1), np.where(any_, hi, 0)], 1)
+
+
 def test_imagined_runs_in_closed_form_are_the_footprint_lines():
     """Contact remakes the imagined object's per-line runs from its kind and position in
-    closed form; they must be exactly the lines of the footprint mask, at any position
-    (off the workspace too) and for no imagined object."""
-    from vccjax.motion import imagined_mask, imagined_runs
+    closed form; they must be exactly the lines of the footprint (geometry.imagined_pixels),
+    at any position (off the workspace too) and for no imagined object."""
+    from vccjax.geometry import imagined_pixels
+    from vccjax.motion import imagined_runs
 
-    def lines(m):  # first and last pixel of each line (1, 0: empty)
-        any_ = m.any(1)
-        lo, hi = np.argmax(m, 1), CFG.raster - 1 - np.argmax(m[:, ::-1], 1)
-        return np.stack([np.where(any_, lo, 1), np.where(any_, hi, 0)], 1)
-
-    both = jax.jit(jax.vmap(lambda k, a: (imagined_mask(k, a, CFG), imagined_runs(k, a, CFG))))
+    runs = jax.jit(jax.vmap(lambda k, a: imagined_runs(k, a, CFG)))
     u = CFG.units
     rng = np.random.default_rng(3)
     at = np.concatenate([rng.integers(-40, u + 40, (400, 2)), [[0, 0], [u, u], [u // 2, u // 2]]]).astype(np.int32)
     for kind in (-1, 0, 1):
-        masks, (rows, cols) = jax.tree.map(np.asarray, both(np.full(len(at), kind, np.int32), at))
-        for m, r, c in zip(masks, rows, cols):
-            assert np.array_equal(lines(m), r) and np.array_equal(lines(m.T), c), (kind, m.sum())
-        assert (kind >= 0) == masks.any()
+        rows, cols = jax.tree.map(np.asarray, runs(np.full(len(at), kind, np.int32), at))
+        painted = 0
+        for (x, y), r, c in zip(at, rows, cols):
+            m = np.zeros((CFG.raster, CFG.raster), bool)
+            if kind >= 0:
+                m[imagined_pixels(kind, int(x), int(y), CFG)] = True
+            assert np.array_equal(_lines(m), r) and np.array_equal(_lines(m.T), c), (kind, x, y)
+            painted += m.any()
+        assert (painted > 0) == (kind >= 0)

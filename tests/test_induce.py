@@ -39,6 +39,16 @@ def _uniform_chain():
     return Chain(v, MarkovModel.uniform(v.size), uniform_args())
 
 
+def _loop_chain():
+    """A model that likes loops (fitted on the reference programs: only to make loops
+    likely here) so that `loop_end` and its host-driven replay are exercised."""
+    from vccjax.concepts import all_concepts
+
+    v = Vocabulary()
+    model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], v.size, 1, 0.1)
+    return Chain(v, model, argument_logp(Settings(args="oracle"), LOOP))
+
+
 @pytest.mark.parametrize("concept", ["remove_bottom_obj", LONG])
 def test_batched_and_scalar_search_visit_the_same_tree(ds, explorer, concept):
     task = Task.from_pairs(ds.pairs(concept, "train"))
@@ -51,13 +61,8 @@ def test_batched_and_scalar_search_visit_the_same_tree(ds, explorer, concept):
 
 
 def test_loops_replayed_on_the_host_agree_with_the_scalar_search(ds, explorer):
-    """A model that likes loops (fitted on the reference programs: only to make loops
-    likely here) so that `loop_end` and its host-driven replay are exercised."""
-    from vccjax.concepts import all_concepts
-
-    v = Vocabulary()
-    model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], v.size, 1, 0.1)
-    chain = Chain(v, model, argument_logp(Settings(args="oracle"), LOOP))
+    """Loops under a model that likes them (`_loop_chain`)."""
+    chain = _loop_chain()
     task = Task.from_pairs(ds.pairs(LOOP, "train"))
     a = explorer.search(chain, task, 3000)
     b = ScalarExplorer().search(chain, task, 3000)
@@ -83,23 +88,17 @@ def test_concepts_explored_together_find_what_each_finds_alone(ds):
     assert sum(together[j].found for j in range(len(names))) >= 3
 
 
-_TWO_DEVICES = """
+_TWO_DEVICES = """  # _loop_chain's search, in a process with two devices
 import json, sys
-import jax
 import numpy as np
-from search.chain import Chain
+folder, concept, here = sys.argv[1:]
+sys.path.insert(0, here)
+from test_induce import _loop_chain
 from search.explore import Explorer, Task
-from search.induce import Settings, argument_logp
-from search.model import MarkovModel, Vocabulary
-from vccjax.concepts import all_concepts
 from vccjax.dataset import Dataset
 
-folder, concept = sys.argv[1:]
-v = Vocabulary()
-model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], v.size, 1, 0.1)
-chain = Chain(v, model, argument_logp(Settings(args="oracle"), concept))
 ex = Explorer()
-r = ex.search(chain, Task.from_pairs(Dataset(folder).pairs(concept, "train")), 3000)
+r = ex.search(_loop_chain(), Task.from_pairs(Dataset(folder).pairs(concept, "train")), 3000)
 spread = ex._rows_of(np.arange(16))(np.arange(16))
 print(json.dumps({"devices": len(ex.devices), "shares": len(spread.sharding.device_set),
                   "result": [r.text, r.rank, r.nodes, r.programs]}))
@@ -114,17 +113,12 @@ def test_batches_split_over_two_devices_give_the_same_search(ds, explorer):
     import sys
 
     env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=2")
-    out = subprocess.run([sys.executable, "-c", _TWO_DEVICES, str(ds.folder), LOOP], env=env,
+    out = subprocess.run([sys.executable, "-c", _TWO_DEVICES, str(ds.folder), LOOP, os.path.dirname(__file__)], env=env,
                          capture_output=True, text=True, timeout=1200)
     assert out.returncode == 0, out.stderr[-2000:]
     two = json.loads(out.stdout.strip().splitlines()[-1])
     assert two["devices"] == 2 and two["shares"] == 2
-    from vccjax.concepts import all_concepts
-
-    v = Vocabulary()
-    model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], v.size, 1, 0.1)
-    one = explorer.search(Chain(v, model, argument_logp(Settings(args="oracle"), LOOP)),
-                          Task.from_pairs(ds.pairs(LOOP, "train")), 3000)
+    one = explorer.search(_loop_chain(), Task.from_pairs(ds.pairs(LOOP, "train")), 3000)
     assert len(explorer.devices) == 1
     assert two["result"] == [one.text, one.rank, one.nodes, one.programs]
 

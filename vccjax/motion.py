@@ -85,24 +85,6 @@ def contains(c: SceneConst, s: VCCState, cfg: VCCConfig, point: jax.Array) -> ja
     return ok & inside
 
 
-def imagined_mask(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> jax.Array:
-    """(R, R) bool footprint (rows, cols) of an imagined circle (kind 0) or hline (kind 1)
-    at `at`, empty for kind -1, with the exact integer tests of geometry.imagined_pixels.
-
-    The state keeps only the kind and position: the footprint is cheap to remake where
-    contact needs it, and 4R fewer integers per state make every batched step cheaper."""
-    u, sub, r = cfg.units, cfg.sub, cfg.raster
-    centres = jnp.arange(r, dtype=jnp.int32) * sub + sub // 2
-    dy = centres - at[1]
-    dx = centres - at[0]
-    fp = jnp.where(
-        kind == 0,
-        16 * (dx[None, :] ** 2 + dy[:, None] ** 2) <= u * u,
-        jnp.broadcast_to((100 * jnp.abs(dy) <= u)[:, None], (r, r)),
-    )
-    return fp & (kind >= 0)
-
-
 def _isqrt(x: jax.Array) -> jax.Array:
     """floor(sqrt(x)) of int32 x in [0, 2**24): float32 root, corrected by one either way."""
     d = jnp.floor(jnp.sqrt(x.astype(jnp.float32))).astype(jnp.int32)
@@ -115,7 +97,8 @@ def imagined_runs(kind: jax.Array, at: jax.Array, cfg: VCCConfig) -> tuple[jax.A
     closed form: on a line at distance d from the centre, a pixel centre c is inside when
     |c - centre| <= reach(d) (circle: 16 (dx^2 + dy^2) <= U^2, so reach = isqrt((U^2 -
     16 d^2) // 16); hline: every pixel of a row within U / 100, so reach = U // 100 down a
-    column). The same pixels as `imagined_mask`, at a fraction of its cost (tested)."""
+    column). The pixels of geometry.imagined_pixels (tested). The state keeps only the kind
+    and position: the runs are remade where contact needs them."""
     u, sub, r = cfg.units, cfg.sub, cfg.raster
     centres = jnp.arange(r, dtype=jnp.int32) * sub + sub // 2
     none = jnp.full(r, -1, jnp.int32)

@@ -221,9 +221,10 @@ class Blackboard:
     offset: jax.Array
 
 
-BLACKBOARD = ("alive", "color", "offset")
+BLACKBOARD = tuple(f.name for f in dataclasses.fields(Blackboard))
 
 
+@functools.lru_cache(maxsize=None)
 def blackboard_columns(cfg: VCCConfig = DEFAULT_CONFIG) -> int:
     """How many leading columns of a packed row hold the blackboard (the layout puts those
     fields first, so judging outputs moves a small slice of each state, not all of it)."""
