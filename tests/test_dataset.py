@@ -11,9 +11,10 @@ from vccjax.concepts import concept_names, reference_program
 from vccjax.config import DEFAULT_CONFIG as CFG
 from vccjax.dataset import Dataset, build_dataset, read_npz, write_npz
 from vccjax.errors import DataFileError
-from vccjax.examples import TEST, TRAIN, Jitter, is_well_posed, uses_pointer
+from vccjax.examples import TEST, TRAIN, Jitter, distinguishes, is_well_posed, uses_pointer
 from vccjax.program import parse
 from vccjax.reference import RefMachine
+from vccjax.rivals import rival_programs
 from vccjax.scene import Scene, SceneObject, scenes_match
 
 SOME = ["swap_locations", "form_circle_shape_using_same_objs", "chained_movement_left_most_object",
@@ -34,6 +35,10 @@ def _assert_complete(folder, names):
         train, test = ds.pairs(name, "train"), ds.pairs(name, "test")
         assert len(train) == TRAIN.count and len(test) == TEST.count, name
         assert all((p[0].pointer is not None) == uses_pointer(reference_program(name)) for p in train)
+        left = ds.rivals_left(name)
+        for label, rival in rival_programs(reference_program(name)):  # the training pairs rule out the rivals
+            told = any(distinguishes(rival, a, b, CFG, Jitter().slack) for a, b in train)
+            assert told != (label in left), (name, label)
 
 
 @pytest.mark.slow  # about 8 minutes on 2 cores; the sample below runs by default
@@ -48,6 +53,8 @@ def test_every_13th_concept_gets_10_train_and_50_test_pairs(tmp_path):
     manifest = build_dataset(tmp_path, names, seed=0, workers=2, progress=False)
     assert manifest["failed"] == {}, manifest["failed"]
     _assert_complete(tmp_path, names)
+    ds = Dataset(tmp_path)
+    assert manifest["rivals_left"] == {n: ds.rivals_left(n) for n in names if ds.rivals_left(n)}
 
 
 def test_an_example_that_hinges_on_a_hair_is_not_well_posed():

@@ -117,6 +117,9 @@ def cmd_dataset_build(a: argparse.Namespace) -> int:
     start = time.time()
     m = build_dataset(a.out, concepts, seed=a.seed, workers=a.workers or os.cpu_count() or 1)
     print(f"{len(m['concepts'])} concepts written to {a.out} (seed {a.seed}) in {time.time() - start:.0f}s")
+    left = m["rivals_left"]
+    print(f"training pairs tell every rival of the reference apart in {len(m['concepts']) - len(left)} concepts;"
+          f" {len(left)} leave some untold (manifest.json: rivals_left)")
     for name, why in m["failed"].items():
         print(f"not built: {name}: {why}")
     return 1 if m["failed"] else 0

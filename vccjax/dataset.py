@@ -26,13 +26,15 @@ import numpy as np
 from vccjax.concepts import concept_names, reference_program
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import DataFileError, read_json
-from vccjax.examples import TEST, TRAIN, ExampleError, make_pairs
+from vccjax.examples import TEST, TRAIN, ExampleError, discriminate, make_pairs
 from vccjax.instructions import COLORS, SHAPES
+from vccjax.rivals import rival_programs
 from vccjax.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
-VERSION = 5  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
-# 4: drawn shapes kept apart (generate.drawn_cover), whole-scene and pointer nudges; 5: each object nudged alone
+VERSION = 6  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
+# 4: drawn shapes kept apart (generate.drawn_cover), whole-scene and pointer nudges; 5: each object nudged alone;
+# 6: training pairs tell the reference from its rivals (rivals.py); rivals left untold are listed per concept
 _FIELDS = 6  # alive, shape, color, x, y, width
 
 
@@ -121,7 +123,12 @@ def build_concept(name: str, index: int, seed: int, cfg: VCCConfig) -> dict[str,
         "seed": np.array([seed], np.int64), "raster": np.array([cfg.raster], np.int32),
     }
     for split_id, (split, spec) in enumerate((("train", TRAIN), ("test", TEST))):
-        pairs = make_pairs(program, spec, _concept_rng(seed, index, split_id), cfg)
+        rng = _concept_rng(seed, index, split_id)
+        pairs = make_pairs(program, spec, rng, cfg)
+        if split == "train":
+            rivals = rival_programs(program)
+            pairs, left = discriminate(program, pairs, [r for _, r in rivals], spec, rng, cfg)
+            arrays["train_rivals_left"] = _text("\n".join(rivals[i][0] for i in left))
         for side, scenes in (("in", [p[0] for p in pairs]), ("out", [p[1] for p in pairs])):
             objs, ptr = scenes_to_arrays(scenes, cfg.n_max)
             arrays[f"{split}_{side}"] = objs
@@ -129,7 +136,8 @@ def build_concept(name: str, index: int, seed: int, cfg: VCCConfig) -> dict[str,
     return arrays
 
 
-def _build_one(job: tuple[str, int, int, VCCConfig, str]) -> tuple[str, str, str | None]:
+def _build_one(job: tuple[str, int, int, VCCConfig, str]) -> tuple[str, str, str | None, list[str]]:
+    """(concept, sha256 of its file, error or None, rivals its training pairs leave untold)."""
     name, index, seed, cfg, out = job
     path = Path(out) / f"c{index:03d}.npz"
     if path.exists():  # resume: keep a finished file if it is intact and from this seed
@@ -137,14 +145,18 @@ def _build_one(job: tuple[str, int, int, VCCConfig, str]) -> tuple[str, str, str
             a = read_npz(path)
             if (int(a["format_version"][0]) == VERSION and int(a["seed"][0]) == seed
                     and bytes(a["concept"]).decode() == name):
-                return name, hashlib.sha256(path.read_bytes()).hexdigest(), None
+                return name, hashlib.sha256(path.read_bytes()).hexdigest(), None, _lines(a["train_rivals_left"])
         except DataFileError:
             pass
     try:
         arrays = build_concept(name, index, seed, cfg)
     except ExampleError as e:
-        return name, "", str(e)
-    return name, write_npz(path, arrays), None
+        return name, "", str(e), []
+    return name, write_npz(path, arrays), None, _lines(arrays["train_rivals_left"])
+
+
+def _lines(text: np.ndarray) -> list[str]:
+    return [line for line in bytes(text).decode().split("\n") if line]
 
 
 def build_dataset(
@@ -181,8 +193,9 @@ def build_dataset(
         "format": FORMAT, "version": VERSION, "seed": seed,
         "config": {"raster": cfg.raster, "n_max": cfg.n_max},
         "splits": {"train": vars_of(TRAIN), "test": vars_of(TEST)},
-        "concepts": {n: {"file": f"c{names.index(n):03d}.npz", "sha256": h} for n, h, err in results if not err},
-        "failed": {n: err for n, _, err in results if err},
+        "concepts": {n: {"file": f"c{names.index(n):03d}.npz", "sha256": h} for n, h, err, _ in results if not err},
+        "failed": {n: err for n, _, err, _ in results if err},
+        "rivals_left": {n: left for n, _, err, left in results if left and not err},
     }
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True))
     return manifest
@@ -228,6 +241,10 @@ class Dataset:
                 raise DataFileError(f"{path}: holds concept {bytes(arrays['concept']).decode()!r}, not {concept!r}")
             self._cache[concept] = arrays
         return self._cache[concept]
+
+    def rivals_left(self, concept: str) -> list[str]:
+        """The rivals of the reference (rivals.py) that no training pair tells apart."""
+        return _lines(self.arrays(concept)["train_rivals_left"])
 
     def pairs(self, concept: str, split: str = "train") -> list[tuple[Scene, Scene]]:
         if split not in ("train", "test"):

@@ -18,6 +18,7 @@ dropped. Without this rule about one pair in twenty-five hinged on a grazing con
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -145,15 +146,29 @@ def is_well_posed(
     return True
 
 
+def _draws(program: Program, spec: ExampleSpec, rng: np.random.Generator, cfg: VCCConfig):
+    """Endless draws: (input, output) where the program runs and changes the input, else None.
+    Draw only as many as are used: the rng goes on to the next step."""
+    pointer = uses_pointer(program)
+    while True:
+        try:
+            scene = random_scene(rng, spec.objects, widths=spec.widths, pointer=pointer, cfg=cfg)
+        except SceneError:
+            yield None  # too crowded to place
+            continue
+        m = RefMachine(scene, cfg, validate=False).run(program)
+        out = None if m.failed else m.output_scene()
+        yield None if out is None or scenes_match(out, scene, cfg.tau) else (scene, out)
+
+
 def make_pairs(
     program: Program, spec: ExampleSpec, rng: np.random.Generator,
     cfg: VCCConfig = DEFAULT_CONFIG, max_tries: int = 30000, jitter: Jitter | None = Jitter(),
 ) -> list[tuple[Scene, Scene]]:
     """`spec.count` well-posed (input, output) pairs on which the program runs and changes
     the scene. `jitter=None` skips the well-posedness rule."""
-    pointer = uses_pointer(program)
     pairs: list[tuple[Scene, Scene]] = []
-    tries = 0
+    draws, tries = _draws(program, spec, rng, cfg), 0
     while len(pairs) < spec.count:
         tries += 1
         if tries > max_tries:
@@ -161,17 +176,53 @@ def make_pairs(
                 f"only {len(pairs)} of {spec.count} pairs after {max_tries} scenes "
                 f"({spec.objects[0]}-{spec.objects[1]} objects)"
             )
-        try:
-            scene = random_scene(rng, spec.objects, widths=spec.widths, pointer=pointer, cfg=cfg)
-        except SceneError:
-            continue  # too crowded to place; draw again
-        m = RefMachine(scene, cfg, validate=False).run(program)
-        if m.failed:
+        drawn = next(draws)
+        if drawn is None or (jitter is not None and not is_well_posed(program, *drawn, jitter, rng, cfg)):
             continue
-        out = m.output_scene()
-        if scenes_match(out, scene, cfg.tau):
-            continue
-        if jitter is not None and not is_well_posed(program, scene, out, jitter, rng, cfg):
-            continue
-        pairs.append((scene, out))
+        pairs.append(drawn)
     return pairs
+
+
+def distinguishes(rival: Program, scene: Scene, out: Scene, cfg: VCCConfig = DEFAULT_CONFIG, margin: float = 0.0) -> bool:
+    """True if `rival` fails on `scene` or its output misses `out` by more than tau + margin."""
+    m = RefMachine(scene, cfg, validate=False).run(rival)
+    return m.failed or not scenes_match(m.output_scene(), out, cfg.tau + margin)
+
+
+def discriminate(
+    program: Program, pairs: list[tuple[Scene, Scene]], rivals: Sequence[Program], spec: ExampleSpec,
+    rng: np.random.Generator, cfg: VCCConfig = DEFAULT_CONFIG, jitter: Jitter | None = Jitter(),
+    patience: int = 400,
+) -> tuple[list[tuple[Scene, Scene]], list[int]]:
+    """Swap pairs in until each rival is told apart from `program` on some pair.
+
+    A drawn input that tells a still-unresolved rival apart replaces a pair that no
+    rival needs (one whose every rival is also told apart elsewhere). Gives up on the
+    rivals left after `patience` usable inputs in a row (the program runs and changes
+    the scene) resolve none: such a rival is taken to be equivalent to the program on
+    this scene distribution. Returns the pairs and the indices of the rivals left.
+    """
+    margin = 0.0 if jitter is None else jitter.slack
+    pairs = list(pairs)
+    told = [{r for r, rival in enumerate(rivals) if distinguishes(rival, a, b, cfg, margin)} for a, b in pairs]
+    left = set(range(len(rivals))) - set().union(*told)
+    draws, idle = _draws(program, spec, rng, cfg), 0
+    while left and idle < patience:
+        drawn = next(draws)
+        if drawn is None:
+            continue
+        idle += 1
+        scene, out = drawn
+        hits = {r for r in left if distinguishes(rivals[r], scene, out, cfg, margin)}
+        if not hits or (jitter is not None and not is_well_posed(program, scene, out, jitter, rng, cfg)):
+            continue
+        spare = [i for i in range(len(pairs))
+                 if all(any(r in told[j] for j in range(len(pairs)) if j != i) for r in told[i])]
+        if not spare:
+            continue  # every pair is some rival's only witness; nothing can go
+        i = spare[-1]
+        told[i] = hits | {r for r in range(len(rivals)) if r not in left and distinguishes(rivals[r], scene, out, cfg, margin)}
+        pairs[i] = drawn
+        left -= hits
+        idle = 0
+    return pairs, sorted(left)
