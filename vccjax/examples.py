@@ -192,7 +192,7 @@ def distinguishes(rival: Program, scene: Scene, out: Scene, cfg: VCCConfig = DEF
 def discriminate(
     program: Program, pairs: list[tuple[Scene, Scene]], rivals: Sequence[Program], spec: ExampleSpec,
     rng: np.random.Generator, cfg: VCCConfig = DEFAULT_CONFIG, jitter: Jitter | None = Jitter(),
-    patience: int = 400,
+    patience: int = 2000,
 ) -> tuple[list[tuple[Scene, Scene]], list[int]]:
     """Swap pairs in until each rival is told apart from `program` on some pair.
 
