@@ -46,6 +46,20 @@ def test_loop_program_has_straight_passes_and_only_valid_deletions():
         check_loop_syntax(rival)
 
 
+def test_each_of_two_loops_is_unrolled_with_the_other_kept():
+    first = "set_color_attn(yellow); loop_start; top_down_attend; move_hand_to_attended_object; grab_object; " \
+            "move_hand_down; release_object; next_object; loop_end"
+    second = "set_color_attn(green); loop_start; top_down_attend; move_hand_to_attended_object; grab_object; " \
+             "move_hand_up; release_object; next_object; loop_end"
+    texts = _texts(parse(f"scene_parse; {first}; reset_attn; {second}"))
+    body1 = first.split("loop_start; ")[1].removesuffix("; loop_end")
+    body2 = second.split("loop_start; ")[1].removesuffix("; loop_end")
+    assert texts["loop 1 as 1 straight pass"] == f"scene_parse; set_color_attn(yellow); {body1}; reset_attn; {second}"
+    assert texts["loop 2 as 2 straight passes"] == (
+        f"scene_parse; {first}; reset_attn; set_color_attn(green); {body2}; {body2}")
+    assert {"loop 1 as 2 straight passes", "loop 2 as 1 straight pass", "parts in order (1, 0)"} <= set(texts)
+
+
 def test_discriminate_rules_out_every_rival_or_says_which_it_could_not():
     rng = np.random.default_rng(5)
     pairs = make_pairs(LOOP, TRAIN, rng)

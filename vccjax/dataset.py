@@ -32,9 +32,10 @@ from vccjax.rivals import rival_programs
 from vccjax.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
-VERSION = 6  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
+VERSION = 7  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
 # 4: drawn shapes kept apart (generate.drawn_cover), whole-scene and pointer nudges; 5: each object nudged alone;
-# 6: training pairs tell the reference from its rivals (rivals.py); rivals left untold are listed per concept
+# 6: training pairs tell the reference from its rivals (rivals.py); rivals left untold are listed per concept;
+# 7: every loop of a program (not only the first) gets the straight-pass rivals
 _FIELDS = 6  # alive, shape, color, x, y, width
 
 
@@ -206,6 +207,31 @@ def vars_of(spec) -> dict:
 
 
 # ---- loading -------------------------------------------------------------------------------
+def shipped_folder() -> Path:
+    """The seed-0 dataset of all 546 concepts, shipped in the package (about 6 MB): what
+    `vcc dataset build` makes with the default seed, byte for byte (a test rebuilds a
+    sample and compares hashes), so that induction needs no hour-long build first."""
+    from importlib import resources
+
+    return Path(str(resources.files("vccjax").joinpath("data/examples")))
+
+
+def dataset_for(concepts: Iterable[str], seed: int, folder: str | Path | None, progress: bool = True) -> Dataset:
+    """`folder` if given; else the shipped dataset for seed 0; else examples built (or
+    resumed) for these concepts under ~/.cache/vccjax/examples-seed{seed}."""
+    if folder is None and seed == 0 and (shipped_folder() / "manifest.json").exists():
+        folder = shipped_folder()
+    elif folder is None:
+        folder = Path.home() / ".cache" / "vccjax" / f"examples-seed{seed}"
+        build_dataset(folder, concepts, seed=seed, progress=progress)
+    ds = Dataset(folder)
+    missing = [c for c in concepts if c not in ds.manifest["concepts"]]
+    if missing:
+        more = " ..." if len(missing) > 5 else ""
+        raise DataFileError(f"{folder}: no examples for {', '.join(missing[:5])}{more}")
+    return ds
+
+
 class Dataset:
     """A built dataset, verified on open; `pairs(concept, split)` gives Scene pairs."""
 
@@ -241,6 +267,13 @@ class Dataset:
                 raise DataFileError(f"{path}: holds concept {bytes(arrays['concept']).decode()!r}, not {concept!r}")
             self._cache[concept] = arrays
         return self._cache[concept]
+
+    def sha256(self, concept: str) -> str:
+        """The manifest's hash of the concept's file: what identifies its examples."""
+        entry = self.manifest["concepts"].get(concept)
+        if entry is None:
+            raise DataFileError(f"{self.folder}: concept {concept!r} is not in this dataset")
+        return entry["sha256"]
 
     def rivals_left(self, concept: str) -> list[str]:
         """The rivals of the reference (rivals.py) that no training pair tells apart."""

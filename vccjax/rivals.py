@@ -12,9 +12,9 @@ on every training pair:
 The training split is therefore made to tell the reference from every rival listed
 here (`examples.discriminate`): each rival fails, or gives another output, on at
 least one training pair. The rivals are simple edits of the reference: one
-instruction deleted (but a last `release_object`), the first loop run as one or two
-straight passes (six concepts have a second loop; it is not unrolled), or the parts
-between `reset_attn` reordered.
+instruction deleted (but a last `release_object`), each loop run as one or two
+straight passes (each loop of the six concepts with two loops in turn, the other left
+as written), or the parts between `reset_attn` reordered.
 """
 
 from __future__ import annotations
@@ -50,11 +50,13 @@ def rival_programs(program: Program) -> list[Rival]:
         if steps[i][0] not in loop_marks:
             add(f"without {NAMES[steps[i][0]]} at {i}", steps[:i] + steps[i + 1 :])
 
-    if OP["loop_start"] in program.ops:  # the first loop only: the dataset (format 6) was built so
-        s, e = program.ops.index(OP["loop_start"]), program.ops.index(OP["loop_end"])
+    starts = [i for i, (op, _) in enumerate(steps) if op == OP["loop_start"]]
+    for n, s in enumerate(starts):  # loops do not nest: each runs to the next loop_end
+        e = next(i for i in range(s + 1, len(steps)) if steps[i][0] == OP["loop_end"])
         body = steps[s + 1 : e]
+        which = f"loop {n + 1}" if len(starts) > 1 else "loop"
         for passes in (1, 2):
-            add(f"loop as {passes} straight pass{'es' * (passes > 1)}", steps[:s] + body * passes + steps[e + 1 :])
+            add(f"{which} as {passes} straight pass{'es' * (passes > 1)}", steps[:s] + body * passes + steps[e + 1 :])
 
     for label, new_steps in _reordered_parts(steps):
         add(label, new_steps)
