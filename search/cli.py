@@ -35,7 +35,7 @@ def concept_list(spec: str) -> list[str]:
 
 def cmd_induce(a: argparse.Namespace) -> int:
     from search.induce import Settings, argument_logp, induce, summary
-    from vccjax.dataset import Dataset, build_dataset
+    from vccjax.dataset import dataset_for
 
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations)
@@ -43,17 +43,11 @@ def cmd_induce(a: argparse.Namespace) -> int:
     if settings.args.startswith("predicted"):
         argument_logp(settings, names[0])  # fails now, with its message, not after building examples
     enable_compile_cache()
-    folder = Path(a.dataset) if a.dataset else Path(a.out) / "dataset"
-    if not a.dataset:  # examples for just these concepts (resumable, seeded)
-        build_dataset(folder, names, seed=a.seed, progress=not a.quiet)
-    ds = Dataset(folder)
-    missing = [c for c in names if c not in ds.concepts]
-    if missing:
-        raise ValueError(f"{folder}: no examples for {', '.join(missing[:5])}"
-                         + (" ..." if len(missing) > 5 else ""))
+    ds = dataset_for(names, a.seed, a.dataset, progress=not a.quiet)
     from search.explore import Explorer
 
-    run = induce(names, ds.pairs, a.out, settings, explorer=Explorer(width=a.width), progress=not a.quiet)
+    run = induce(names, ds.pairs, a.out, settings, explorer=Explorer(width=a.width), progress=not a.quiet,
+                 examples_sha256=ds.sha256)
     s = summary(run, names)
     (Path(a.out) / "summary.json").write_text(json.dumps(s, indent=1))
     print(f"{'concepts':<28}{s['concepts']}")
@@ -61,6 +55,8 @@ def cmd_induce(a: argparse.Namespace) -> int:
     print(f"{'exact on all test pairs':<28}{s['exact_on_all_test_pairs']}")
     for it, k in s["per_iteration"].items():
         print(f"{'  new in iteration ' + str(it):<28}{k}")
+    print(f"{'  without subroutines':<28}{s['found_without_subroutines']}")
+    print(f"{'wall time (s)':<28}{s['wall_seconds']} (all sessions of this run)")
     print(f"{'search time (s)':<28}{s['search_seconds']} (+{s['compile_seconds']} compiling)")
     print(f"{'programs searched':<28}{s['programs_covered']} ({s['programs_run']} run, rest pruned)")
     print(f"throughput: {s['programs_per_second']} programs/s searched, "
@@ -86,8 +82,10 @@ def add_commands(sub) -> None:
     p.add_argument("--subroutines", choices=["on", "off"], default="on")
     p.add_argument("--epsilon", type=float, default=0.1, help="pseudocount (default 0.1)")
     p.add_argument("--iterations", type=int, default=8, help="explore-compress iterations at most")
-    p.add_argument("--dataset", help="a built dataset folder (default: build OUT/dataset for these concepts)")
-    p.add_argument("--seed", type=int, default=0, help="dataset seed when building (default 0)")
+    p.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax, seed 0)")
+    p.add_argument("--seed", type=int, default=0,
+                   help="examples' seed without --dataset: 0 (default) is the shipped dataset; another "
+                        "builds these concepts' examples under ~/.cache/vccjax")
     p.add_argument("--width", type=int, default=32,
                    help="concepts searched in lockstep, their programs stepped in shared batches (default 32)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")

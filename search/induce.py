@@ -9,7 +9,8 @@ model finds nothing new, or after `max_iterations`.
 Reference programs are read only to make examples and, for `--args oracle` and the
 teacher's fixation guidance, for their arguments.
 
-Files under `out/`: `run.json` (the settings; a resume must match them),
+Files under `out/`: `run.json` (the settings and each concept's examples hash; a
+resume must match them),
 `results.jsonl` (one line per concept tried per iteration, written as soon as it is
 known), `model-K.json` (the model searched with in iteration K).
 """
@@ -19,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -132,6 +134,10 @@ class Run:
                 )
         else:
             meta.write_text(json.dumps({"format": "vccjax-induce", "version": 1, "settings": mine}, indent=1))
+        info = json.loads(meta.read_text())
+        info.setdefault("sessions", []).append(round(time.time(), 3))  # starts, for the wall time
+        self.session = len(info["sessions"]) - 1
+        self._write_meta(info)
         self.results_path = self.out / "results.jsonl"
         self.records: list[dict] = []
         if self.results_path.exists():
@@ -145,6 +151,28 @@ class Run:
                     raise DataFileError(f"{self.results_path}: line {i + 1} is not JSON") from None
             self.results_path.write_text("".join(json.dumps(r) + "\n" for r in self.records))
 
+    def check_examples(self, hashes: dict[str, str]) -> None:
+        """Record each concept's examples hash; refuse a resume on other examples (a
+        rebuilt or different dataset would mix two runs in one results file)."""
+        meta = self.out / "run.json"
+        info = json.loads(meta.read_text())
+        known = info.setdefault("examples_sha256", {})
+        changed = sorted(c for c, h in hashes.items() if known.get(c, h) != h)
+        if changed:
+            raise DataFileError(
+                f"{meta}: this run searched other examples for {', '.join(changed[:3])}"
+                + (f" and {len(changed) - 3} more" if len(changed) > 3 else "")
+                + "; use the dataset it was started with, or another --out"
+            )
+        if any(c not in known for c in hashes):
+            known.update(hashes)
+            self._write_meta(info)
+
+    def _write_meta(self, info: dict) -> None:
+        tmp = self.out / "run.json.tmp"
+        tmp.write_text(json.dumps(info, indent=1))
+        tmp.replace(self.out / "run.json")  # whole or not at all, if killed while writing
+
     def found(self) -> dict[str, dict]:
         return {r["concept"]: r for r in self.records if r["found"]}
 
@@ -152,6 +180,7 @@ class Run:
         return {r["concept"] for r in self.records if r["iteration"] == iteration}
 
     def append(self, record: dict) -> None:
+        record = {**record, "session": self.session, "at": round(time.time(), 3)}
         self.records.append(record)
         with self.results_path.open("a") as f:
             f.write(json.dumps(record) + "\n")
@@ -173,11 +202,15 @@ def induce(
     concepts: Sequence[str], pairs: Callable[[str, str], list[tuple[Scene, Scene]]],
     out: str | Path, settings: Settings, explorer: Explorer | None = None,
     progress: bool = True, log: Callable[[str], None] = print,
+    examples_sha256: Callable[[str], str] | None = None,
 ) -> Run:
-    """Explore-compress over `concepts`; `pairs(concept, split)` gives examples."""
+    """Explore-compress over `concepts`; `pairs(concept, split)` gives examples, and
+    `examples_sha256(concept)`, when given, names them so a resume can check them."""
     from tqdm import tqdm
 
     run = Run(out, settings)
+    if examples_sha256 is not None:
+        run.check_examples({c: examples_sha256(c) for c in concepts})
     explorer = explorer or Explorer()
     subs_on = False
     for it in range(settings.max_iterations):
@@ -196,13 +229,13 @@ def induce(
         todo = [c for c in concepts if c not in done]
         bar = tqdm(total=len(todo), desc=f"iteration {it}", disable=not progress, unit="concept")
 
-        def done(j: int, r: Result, it: int = it, bar=bar) -> None:
+        def done(j: int, r: Result, it: int = it, bar=bar, todo=todo, subs: int = len(vocab.bodies)) -> None:
             c = todo[j]
             test = None
             if r.found:
                 tp = pairs(c, "test")
                 test = (generalization(r.program, tp, DEFAULT_CONFIG.tau), len(tp))
-            run.append(_record(c, it, r, test))
+            run.append({**_record(c, it, r, test), "subroutines": subs})
             bar.update()
             bar.set_postfix(found=len(run.found()))
 
@@ -223,20 +256,34 @@ def induce(
     return run
 
 
+def wall_seconds(run: Run) -> float:
+    """The run's wall time over all its sessions: each from its start to its last record
+    (a session killed later loses only the time after that record)."""
+    starts = json.loads((run.out / "run.json").read_text()).get("sessions", [])
+    total = 0.0
+    for k, start in enumerate(starts):
+        ats = [r["at"] for r in run.records if r.get("session") == k and "at" in r]
+        total += max(ats) - start if ats else 0.0
+    return total
+
+
 def summary(run: Run, concepts: Sequence[str]) -> dict:
     recs = [r for r in run.records if r["concept"] in set(concepts)]
     found = {r["concept"]: r for r in recs if r["found"]}
-    wall = sum(r["seconds"] for r in recs)
-    secs = wall - sum(r.get("compile_seconds", 0.0) for r in recs)
+    spent = sum(r["seconds"] for r in recs)  # each concept's share of the lockstep rounds
+    secs = spent - sum(r.get("compile_seconds", 0.0) for r in recs)
     covered = sum(r["covered"] for r in recs)
     exact = sum(1 for r in found.values() if r["test_correct"] == r["test_total"])
     return {
         "concepts": len(set(concepts)), "found": len(found), "exact_on_all_test_pairs": exact,
-        "search_seconds": round(secs, 1), "compile_seconds": round(wall - secs, 1),
+        "wall_seconds": round(wall_seconds(run), 1),
+        "search_seconds": round(secs, 1), "compile_seconds": round(spent - secs, 1),
         "programs_covered": covered,
         "programs_run": sum(r["programs_run"] for r in recs), "nodes": sum(r["nodes"] for r in recs),
         "programs_per_second": round(covered / secs) if secs else None,
         "programs_run_per_second": round(sum(r["programs_run"] for r in recs) / secs) if secs else None,
+        # what the same run with subroutines off finds: it stops where this one turns them on
+        "found_without_subroutines": sum(1 for r in found.values() if not r.get("subroutines")),
         "per_iteration": {
             it: sum(1 for r in recs if r["iteration"] == it and r["found"])
             for it in sorted({r["iteration"] for r in recs})

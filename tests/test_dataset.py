@@ -9,7 +9,7 @@ import pytest
 
 from vccjax.concepts import concept_names, reference_program
 from vccjax.config import DEFAULT_CONFIG as CFG
-from vccjax.dataset import Dataset, build_dataset, read_npz, write_npz
+from vccjax.dataset import Dataset, build_dataset, read_npz, shipped_folder, write_npz
 from vccjax.errors import DataFileError
 from vccjax.examples import TEST, TRAIN, Jitter, distinguishes, is_well_posed, uses_pointer
 from vccjax.program import parse
@@ -55,6 +55,10 @@ def test_every_13th_concept_gets_10_train_and_50_test_pairs(tmp_path):
     _assert_complete(tmp_path, names)
     ds = Dataset(tmp_path)
     assert manifest["rivals_left"] == {n: ds.rivals_left(n) for n in names if ds.rivals_left(n)}
+    # the dataset shipped in the package is what this code builds, byte for byte
+    shipped = Dataset(shipped_folder())
+    assert {n: shipped.sha256(n) for n in names} == {n: ds.sha256(n) for n in names}
+    assert sorted(shipped.concepts) == sorted(concept_names())
 
 
 def test_an_example_that_hinges_on_a_hair_is_not_well_posed():

@@ -163,14 +163,15 @@ def test_interrupted_run_resumes_without_losing_or_redoing(ds, tmp_path):
     settings = Settings(budget=3000, args="oracle", max_iterations=2)
     out = tmp_path / "run"
     with pytest.raises(KeyboardInterrupt):
-        induce(SHORT, ds.pairs, out, settings, explorer=CountingExplorer(fail_after=2), progress=False)
+        induce(SHORT, ds.pairs, out, settings, explorer=CountingExplorer(fail_after=2), progress=False,
+               examples_sha256=ds.sha256)
     first = [json.loads(x) for x in (out / "results.jsonl").read_text().splitlines()]
     assert len(first) == 2 and {r["concept"] for r in first} < set(SHORT) and all(r["found"] for r in first)
     # a line half written when the process died is dropped and its concept redone
     with (out / "results.jsonl").open("a") as f:
         f.write('{"concept": "remove_left_most_obj", "fou')
     again = CountingExplorer()
-    run = induce(SHORT, ds.pairs, out, settings, explorer=again, progress=False)
+    run = induce(SHORT, ds.pairs, out, settings, explorer=again, progress=False, examples_sha256=ds.sha256)
     assert len(again.calls) == 1  # only the concept not yet done
     found = run.found()
     assert set(found) == set(SHORT)
@@ -181,6 +182,12 @@ def test_interrupted_run_resumes_without_losing_or_redoing(ds, tmp_path):
     # the same folder with other settings is refused, not mixed
     with pytest.raises(DataFileError, match="other settings"):
         Run(out, Settings(budget=4000, args="oracle", max_iterations=2))
+    # ... and so are other examples (a rebuilt dataset), before anything is searched
+    other = CountingExplorer()
+    with pytest.raises(DataFileError, match="other examples for remove_"):
+        induce(SHORT, ds.pairs, out, settings, explorer=other, progress=False,
+               examples_sha256=lambda c: "0" * 64 if c == SHORT[0] else ds.sha256(c))
+    assert other.calls == [] and len((out / "results.jsonl").read_text().splitlines()) == len(run.records)
 
 
 def test_cli_induce_runs_and_reports(tmp_path, capsys, monkeypatch):
@@ -193,10 +200,14 @@ def test_cli_induce_runs_and_reports(tmp_path, capsys, monkeypatch):
     assert "induced" in text and "programs/s" in text
     summary = json.loads((out / "summary.json").read_text())
     assert summary["found"] == 2 and summary["exact_on_all_test_pairs"] == 2
+    assert summary["found_without_subroutines"] == 2  # iteration 0 has none
+    assert 0 < summary["search_seconds"] <= summary["wall_seconds"] + 1
     # rerun: everything is already there, nothing is searched again
     assert main(argv) == 0
     lines = (out / "results.jsonl").read_text().splitlines()
     assert len(lines) == 2
+    meta = json.loads((out / "run.json").read_text())
+    assert len(meta["sessions"]) == 2 and set(meta["examples_sha256"]) == {"remove_bottom_obj", "remove_top_obj"}
 
 
 @pytest.mark.parametrize("argv, msg", [
@@ -209,6 +220,34 @@ def test_cli_induce_errors_are_one_line(tmp_path, capsys, argv, msg, monkeypatch
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert msg in err and len(err.splitlines()) == 1
+
+
+def test_cli_induce_refuses_a_dataset_without_the_concept_or_other_examples(tmp_path, capsys, monkeypatch):
+    import shutil
+
+    from vccjax.dataset import shipped_folder
+
+    monkeypatch.setenv("VCCJAX_CACHE", "off")
+    part = tmp_path / "part"
+    part.mkdir()
+    manifest = json.loads((shipped_folder() / "manifest.json").read_text())
+    entry = manifest["concepts"]["remove_bottom_obj"]
+    shutil.copy(shipped_folder() / entry["file"], part / entry["file"])
+    (part / "manifest.json").write_text(json.dumps({**manifest, "concepts": {"remove_bottom_obj": entry}}))
+    argv = ["induce", "--concepts", "remove_top_obj", "--out", str(tmp_path / "run"), "--dataset", str(part)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "no examples for remove_top_obj" in err and len(err.splitlines()) == 1
+    # a run started on the shipped examples does not resume on other ones
+    run = ["induce", "--concepts", "remove_bottom_obj", "--out", str(tmp_path / "run"), "--budget", "500",
+           "--iterations", "1", "--quiet"]
+    assert main(run) == 0
+    capsys.readouterr()
+    entry["sha256"] = "0" * 64  # as if rebuilt differently: the manifest names other bytes
+    (part / "manifest.json").write_text(json.dumps({**manifest, "concepts": {"remove_bottom_obj": entry}}))
+    assert main([*run, "--dataset", str(part)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "other examples for remove_bottom_obj" in err and len(err.splitlines()) == 1
 
 
 DOZEN = ["change_target_obj_to_given_color", "change_target_position_to_given_color", "remove_bottom_obj",

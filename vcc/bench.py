@@ -47,13 +47,10 @@ def _search_jobs(a: argparse.Namespace):
     from search.induce import Settings, argument_logp
     from search.model import MarkovModel, Vocabulary
     from vccjax.concepts import all_concepts, concept_names
-    from vccjax.dataset import Dataset, build_dataset
+    from vccjax.dataset import dataset_for
 
     names = concept_list(a.concepts) if a.concepts else concept_names()[:: max(1, 546 // a.sample)][: a.sample]
-    folder = Path(a.dataset) if a.dataset else Path.home() / ".cache" / "vccjax" / "examples-seed0"
-    if not a.dataset:
-        build_dataset(folder, names, seed=0, progress=False)
-    ds = Dataset(folder)
+    ds = dataset_for(names, 0, a.dataset, progress=False)
     vocab = Vocabulary()
     if a.model == "uniform":
         model = MarkovModel.uniform(vocab.size, 1)
@@ -132,7 +129,6 @@ def add_commands(sub) -> None:
                    help="uniform: explore-compress iteration 0; reference: an order-1 model fitted "
                         "on the reference programs, standing in for a late iteration (deeper trees)")
     s.add_argument("--width", type=int, default=32, help="concepts in lockstep (default 32)")
-    s.add_argument("--dataset", help="a built dataset folder (default: build the concepts' examples, "
-                                     "seed 0, under ~/.cache/vccjax)")
+    s.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
     s.add_argument("--out", default="benchmarks/results/search.json", help="result JSON")
     s.set_defaults(fn=cmd_bench_search)
