@@ -34,14 +34,16 @@ def concept_list(spec: str) -> list[str]:
 
 
 def cmd_induce(a: argparse.Namespace) -> int:
-    from search.induce import Settings, argument_logp, induce, summary
+    from search.induce import Settings, induce, summary
     from vccjax.dataset import dataset_for
 
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations)
     names = concept_list(a.concepts)
     if settings.args.startswith("predicted"):
-        argument_logp(settings, names[0])  # fails now, with its message, not after building examples
+        from argpred.predict import default_predictor
+
+        default_predictor()  # a missing or corrupt weights file fails now, with its message
     enable_compile_cache()
     ds = dataset_for(names, a.seed, a.dataset, progress=not a.quiet)
     from search.explore import Explorer

@@ -70,24 +70,30 @@ def _uniform_over_used(program: Program, name: str) -> np.ndarray:
     return lp
 
 
-def argument_logp(settings: Settings, concept: str) -> dict[int, np.ndarray]:
+def argument_logp(settings: Settings, concept: str,
+                  pairs: Sequence[tuple[Scene, Scene]] | None = None) -> dict[int, np.ndarray]:
     """log p(argument | instruction) for one concept under the settings' mode.
 
     oracle: uniform over the values its reference program uses; an instruction with
     arguments that the program never uses is left out (what a perfect predictor gives).
+    predicted: `set_shape_attn`, `set_color_attn` and `fill_color` from the argument
+    CNN on the concept's training `pairs` (arguments under 0.55 dropped, an instruction
+    with none left out; `argpred.predict`); `fixate` and `imagine_object` uniform.
     +fixation: `fixate` takes the teacher's value (the reference program's)."""
     mode = settings.args
-    if mode.startswith("predicted"):
-        raise NotImplementedError(
-            "--args predicted needs the argument predictor (argpred), which is not built yet; "
-            "use uniform, uniform+fixation or oracle"
-        )
-    ref = reference_program(concept)
-    if mode == "oracle":
-        return {OP[name]: _uniform_over_used(ref, name) for name in NAMES if arg_domain(name)}
     out = uniform_args()
+    if mode == "oracle":
+        ref = reference_program(concept)
+        return {OP[name]: _uniform_over_used(ref, name) for name in NAMES if arg_domain(name)}
+    if mode.startswith("predicted"):
+        from argpred.predict import argument_logp as predicted, default_predictor
+
+        if pairs is None:
+            raise ValueError("--args predicted needs the concept's training pairs")
+        for name, lp in predicted(default_predictor().for_pairs(pairs)).items():
+            out[OP[name]] = lp
     if mode.endswith("+fixation"):
-        out[OP["fixate"]] = _uniform_over_used(ref, "fixate")
+        out[OP["fixate"]] = _uniform_over_used(reference_program(concept), "fixate")
     return out
 
 
@@ -239,8 +245,11 @@ def induce(
             bar.update()
             bar.set_postfix(found=len(run.found()))
 
-        jobs = [(Chain(vocab, model, argument_logp(settings, c), settings.delta), Task.from_pairs(pairs(c, "train")))
-                for c in todo]
+        jobs = []
+        for c in todo:
+            train = pairs(c, "train")
+            chain = Chain(vocab, model, argument_logp(settings, c, train), settings.delta)
+            jobs.append((chain, Task.from_pairs(train)))
         explorer.search_many(jobs, settings.budget, done)
         bar.close()
         n_new = sum(1 for r in run.records if r["iteration"] == it and r["found"])

@@ -139,7 +139,7 @@ def test_oracle_arguments_exclude_unused_instructions():
 
     assert (lp[OP["fixate"]] == 0).sum() == 1
     assert all(v == float("-inf") for v in lp[OP["set_color_attn"]])
-    with pytest.raises(NotImplementedError, match="argument predictor"):
+    with pytest.raises(ValueError, match="training pairs"):
         argument_logp(Settings(args="predicted"), "remove_bottom_obj")
 
 
@@ -212,7 +212,6 @@ def test_cli_induce_runs_and_reports(tmp_path, capsys, monkeypatch):
 
 @pytest.mark.parametrize("argv, msg", [
     (["induce", "--concepts", "no_such_concept", "--out", "X"], "unknown concept"),
-    (["induce", "--concepts", "remove_top_obj", "--out", "X", "--args", "predicted"], "argument predictor"),
     (["induce", "--concepts", "remove_top_obj", "--out", "X", "--budget", "0"], "budget"),
 ])
 def test_cli_induce_errors_are_one_line(tmp_path, capsys, argv, msg, monkeypatch):

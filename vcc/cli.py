@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from argpred import cli as argpred_cli
 from search import cli as search_cli
 from vcc import bench
 from vccjax import cli as vccjax_cli
@@ -19,6 +20,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     vccjax_cli.add_commands(sub)
     search_cli.add_commands(sub)
+    argpred_cli.add_commands(sub)
     bench.add_commands(sub)
     return p
 

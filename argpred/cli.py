@@ -1,0 +1,104 @@
+"""`vcc argpred data|train|eval`: the argument predictor's data, training and recall."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+DEFAULT_DATA = Path.home() / ".cache" / "vccjax" / "argpred-data"
+
+
+def cmd_data(a: argparse.Namespace) -> int:
+    import os
+
+    from argpred.data import build
+
+    m = build(a.out, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
+    print(f"{len(m['shards'])} shards ({len(m['shards']) * m['shard']} programs) in {a.out}")
+    return 0
+
+
+def cmd_train(a: argparse.Namespace) -> int:
+    import os
+    import time
+
+    from argpred import data as argdata
+    from argpred.train import TrainSettings, train
+    from argpred.weights import save
+
+    folder = Path(a.data) if a.data else DEFAULT_DATA / f"seed{a.seed}-{a.programs}"
+    start = time.time()
+    argdata.build(folder, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
+    data = argdata.load(folder)
+    settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, epochs=a.epochs, batch=a.batch,
+                             learning_rate=a.lr, l1=a.l1, seed=a.seed)
+    out = Path(a.out)
+    model, params, history = train(data, settings, checkpoint=out.with_suffix(".ckpt"), progress=not a.quiet)
+    sha = save(out, model, params, {"settings": {k: getattr(settings, k) for k in settings.__dataclass_fields__},
+                                    "programs": int(len(data["labels"])), "history": history})
+    last = history[-1]
+    print(f"trained on {len(data['labels'])} programs in {time.time() - start:.0f}s: "
+          f"train bce {last['train_bce']:.4f}, held-out bce {last.get('val_bce', float('nan')):.4f}, "
+          f"held-out programs with every label right {last.get('val_all_labels_right', float('nan')):.3f}")
+    print(f"weights: {out} (sha256 {sha})")
+    return 0
+
+
+def cmd_eval(a: argparse.Namespace) -> int:
+    from argpred.predict import Predictor
+    from argpred.recall import recall
+    from vccjax.concepts import concept_names
+    from vccjax.dataset import dataset_for
+
+    names = concept_names() if a.concepts == "all" else [c.strip() for c in a.concepts.split(",") if c.strip()]
+    ds = dataset_for(names, 0, a.dataset, progress=False)
+    r = recall(Predictor(a.weights), names, lambda c: ds.pairs(c, "train"))
+    if a.json:
+        Path(a.json).write_text(json.dumps(r, indent=1))
+    for c, miss in list(r["missed"].items())[: a.show]:
+        print(f"missed  {c}: " + "; ".join(f"{f}({', '.join(v)})" for f, v in miss.items()))
+    print("mean extra arguments per function: "
+          + ", ".join(f"{f} {v:.2f}" for f, v in r["mean_extra_arguments"].items()))
+    print(f"concepts recalled: {r['recalled']} of {r['concepts']}")
+    print(f"recall: {r['recall']:.4f}")
+    return 0
+
+
+def add_commands(sub) -> None:
+    p = sub.add_parser("argpred", help="argument prediction: training data, training, recall on the concepts")
+    s = p.add_subparsers(dest="action", required=True, metavar="ACTION")
+    d = s.add_parser("data", help="draw training programs and their examples (resumable, seeded)")
+    d.add_argument("--out", required=True, help="data folder (an existing one is resumed)")
+    d.add_argument("--programs", type=int, default=3000, help="programs to draw (default 3000)")
+    d.add_argument("--seed", type=int, default=0)
+    d.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")
+    d.add_argument("--quiet", action="store_true")
+    d.set_defaults(fn=cmd_data)
+
+    t = s.add_parser("train", help="train the CNN (data built or resumed first); checkpoints every epoch",
+                     description="Build (or reuse) the training programs, train the argument CNN with "
+                                 "optax, and write the weights (msgpack + JSON card with its sha256). "
+                                 "An interrupted run resumes from OUT.ckpt. The defaults reproduce the "
+                                 "shipped weights.")
+    t.add_argument("--out", default="argpred-weights.msgpack", help="weights file (default argpred-weights.msgpack)")
+    t.add_argument("--data", help=f"data folder (default {DEFAULT_DATA}/seedS-N)")
+    t.add_argument("--programs", type=int, default=3000, help="training programs (default 3000)")
+    t.add_argument("--epochs", type=int, default=30)
+    t.add_argument("--batch", type=int, default=64)
+    t.add_argument("--lr", type=float, default=3e-3, help="Adam learning rate")
+    t.add_argument("--l1", type=float, default=1e-4, help="L1 weight on the kernels")
+    t.add_argument("--hidden", type=int, default=32, help="hidden channels (0: the paper's single convolution)")
+    t.add_argument("--kernel", type=int, default=3)
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--workers", type=int, default=0, help="processes for the data (default: one per core)")
+    t.add_argument("--quiet", action="store_true")
+    t.set_defaults(fn=cmd_train)
+
+    e = s.add_parser("eval", help="recall on the 546 concepts' training pairs; prints `recall: X` last")
+    e.add_argument("--weights", help="weights file (default: the shipped weights)")
+    e.add_argument("--concepts", default="all")
+    e.add_argument("--dataset", help="dataset folder (default: the shipped one)")
+    e.add_argument("--json", help="also write the full report here")
+    e.add_argument("--show", type=int, default=10, help="missed concepts to list (default 10)")
+    e.set_defaults(fn=cmd_eval)

@@ -1,0 +1,229 @@
+"""Training data for the argument predictor: short programs and their examples.
+
+The paper enumerates every valid program up to length 6 (scene_parse included), keeps
+those that change their inputs and in which every instruction with its argument is
+indispensable, and makes 10 examples of each. Enumerating is some 10^7 programs here,
+most of them thrown away by the filters, so we draw programs instead: uniformly over
+the instructions and their arguments, a length uniform in 2..6, loop syntax enforced,
+and apply the same filters exactly:
+- valid: 10 input scenes of the training split on which it runs (no failure) and
+  changes the scene (`examples.make_pairs`, inputs drawn as for the concepts);
+- indispensable: deleting any one instruction (but scene_parse) makes it fail or
+  changes some output; a deletion that breaks loop syntax counts as indispensable.
+No concept of the 546 is used. Programs are drawn in shards, each seeded by (seed,
+shard), and written as they finish, so a build resumes and gives the same bytes.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from argpred.features import MAX_OBJECTS, scene_cells
+from vccjax.config import DEFAULT_CONFIG
+from vccjax.errors import DataFileError, ProgramSyntaxError, SceneError
+from vccjax.examples import TRAIN, ExampleError, distinguishes, make_pairs
+from vccjax.generate import random_scene
+from vccjax.instructions import NAMES, OP, arg_domain
+from vccjax.program import Program, check_loop_syntax
+from vccjax.reference import RefMachine
+from vccjax.scene import Scene, scenes_match
+
+PREDICTED: tuple[str, ...] = ("set_shape_attn", "set_color_attn", "fill_color")
+LABELS: tuple[tuple[str, str], ...] = tuple((f, v) for f in PREDICTED for v in arg_domain(f))
+FORMAT, VERSION = "vccjax-argpred-data", 1
+SHARD = 100  # programs per shard file
+LENGTHS = (3, 6)  # scene_parse and one instruction change no scene
+_DRAWABLE = tuple(op for op in range(len(NAMES)) if op != OP["scene_parse"])
+
+
+def labels_of(program: Program) -> np.ndarray:
+    """(13,) 1 for each (function, argument) the program uses."""
+    used = {(NAMES[o], arg_domain(NAMES[o])[a]) for o, a in zip(program.ops, program.args) if NAMES[o] in PREDICTED}
+    return np.array([lab in used for lab in LABELS], np.int8)
+
+
+def grow(rng: np.random.Generator, scenes: list[Scene], length: int) -> Program | None:
+    """A program of `length` instructions that runs on every scene: scene_parse, then at
+    each step an instruction (and argument) drawn uniformly among those that neither fail
+    on any scene nor break loop syntax (None if the draw runs into a dead end)."""
+    machines = [RefMachine(s, validate=False) for s in scenes]
+    for m in machines:
+        m.step(OP["scene_parse"])
+    ops, args = [OP["scene_parse"]], [0]
+    steps = [(o, a) for o in _DRAWABLE for a in range(max(1, len(arg_domain(NAMES[o]))))]
+    while len(ops) < length:
+        for k in rng.permutation(len(steps)):
+            op, arg = steps[k]
+            try:
+                check_loop_syntax(Program((*ops, op), (*args, arg)), complete=len(ops) + 1 == length)
+            except ProgramSyntaxError:
+                continue
+            trial = [m.clone() for m in machines]
+            for m in trial:
+                m.step(op, arg)
+            if any(m.failed for m in trial):
+                continue
+            if NAMES[op] not in ("loop_start", "loop_end") and not any(m.in_loop for m in trial) and all(
+                    _signature(a) == _signature(b) for a, b in zip(machines, trial)):
+                continue  # changes nothing the machine shows: it could only be dispensable
+            machines, ops, args = trial, [*ops, op], [*args, arg]
+            break
+        else:
+            return None
+    return Program(tuple(ops), tuple(args))
+
+
+def _signature(m: RefMachine) -> tuple:
+    """What a step can change that a later step can read (the fixation history aside)."""
+    return (tuple((o.x, o.y, o.color, o.alive) for o in m.objects), m.imagined, m.fovea, m.hand, m.held,
+            m.shape_filter, m.color_filter, tuple(m.attended_list), m.stale, m.k, m.attended)
+
+
+def indispensable(program: Program, pairs) -> bool:
+    """Deleting any one instruction (but scene_parse) fails or changes some output."""
+    for i in range(1, len(program)):
+        rival = Program(program.ops[:i] + program.ops[i + 1 :], program.args[:i] + program.args[i + 1 :])
+        try:
+            check_loop_syntax(rival)
+        except ProgramSyntaxError:
+            continue
+        if not any(distinguishes(rival, a, b) for a, b in pairs):
+            return False
+    return True
+
+
+def scene_pool(rng: np.random.Generator, size: int = 200) -> dict[bool, list[Scene]]:
+    """Inputs to grow programs on, with and without a pointer (drawing a scene costs
+    about 2 ms: a pool is drawn once per shard)."""
+    pool: dict[bool, list[Scene]] = {False: [], True: []}
+    for pointer in (False, True):
+        while len(pool[pointer]) < size:
+            try:
+                pool[pointer].append(random_scene(rng, TRAIN.objects, widths=TRAIN.widths, pointer=pointer))
+            except SceneError:
+                continue
+    return pool
+
+
+def kept_program(rng: np.random.Generator, pool: dict[bool, list[Scene]],
+                 probes: int = 3, max_tries: int = 60) -> tuple[Program, list[tuple[Scene, Scene]]]:
+    """Draw until a program passes the filters; (program, its 10 pairs). A program grows
+    on `probes` pool scenes (half the draws with a pointer) and must change one of them;
+    its 10 examples are then drawn afresh (`examples.make_pairs`: it runs on each input
+    and changes it), and every instruction must be indispensable on them."""
+    while True:
+        scenes = pool[bool(rng.integers(2))]
+        probe = [scenes[int(k)] for k in rng.choice(len(scenes), probes, replace=False)]
+        program = grow(rng, probe, int(rng.integers(LENGTHS[0], LENGTHS[1] + 1)))
+        if program is None:
+            continue
+        outs = [RefMachine(s, validate=False).run(program).output_scene() for s in probe]
+        if all(scenes_match(o, s, DEFAULT_CONFIG.tau) for o, s in zip(outs, probe)):
+            continue  # changes nothing it was grown on
+        try:
+            pairs = make_pairs(program, TRAIN, rng, jitter=None, max_tries=max_tries)
+        except ExampleError:
+            continue
+        if indispensable(program, pairs):
+            return program, pairs
+
+
+def build_shard(seed: int, shard: int, size: int = SHARD) -> dict[str, np.ndarray]:
+    rng = np.random.default_rng([seed, shard, 0xA59])
+    progs, ins, outs = [], [], []
+    seen: set = set()
+    pool = scene_pool(rng)
+    while len(progs) < size:
+        program, pairs = kept_program(rng, pool)
+        if (program.ops, program.args) in seen:
+            continue
+        seen.add((program.ops, program.args))
+        progs.append(program)
+        ins.append(np.stack([scene_cells(a) for a, _ in pairs]))
+        outs.append(np.stack([scene_cells(b) for _, b in pairs]))
+    text = "\n".join(p.text() for p in progs)
+    return {
+        "format_version": np.array([VERSION], np.int32), "seed": np.array([seed, shard], np.int64),
+        "programs": np.frombuffer(text.encode(), np.uint8),
+        "inputs": np.stack(ins), "outputs": np.stack(outs),  # (P, 10, 9, 4) int8 cells
+        "labels": np.stack([labels_of(p) for p in progs]),
+    }
+
+
+def _sha(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def build(out: str | Path, programs: int, seed: int = 0, workers: int = 1,
+          progress: bool = True) -> dict:
+    """Build (or resume) `programs` training programs (rounded up to shards) under `out`."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from tqdm import tqdm
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    n = -(-programs // SHARD)
+    todo = [k for k in range(n) if not _valid_shard(out / f"shard{k:04d}.npz", seed, k)]
+    bar = tqdm(total=n, initial=n - len(todo), desc="argpred data", unit="shard", disable=not progress)
+    if workers > 1 and len(todo) > 1:
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+            for _ in pool.map(_write_shard, [(out, seed, k) for k in todo]):
+                bar.update()
+    else:
+        for k in todo:
+            _write_shard((out, seed, k))
+            bar.update()
+    bar.close()
+    manifest = {"format": FORMAT, "version": VERSION, "seed": seed, "shard": SHARD,
+                "labels": [list(x) for x in LABELS], "max_objects": MAX_OBJECTS,
+                "shards": {f"shard{k:04d}.npz": _sha(out / f"shard{k:04d}.npz") for k in range(n)}}
+    (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
+    return manifest
+
+
+def _write_shard(job) -> None:
+    out, seed, k = job
+    arrays = build_shard(seed, k)
+    tmp = out / f"shard{k:04d}.tmp.npz"
+    np.savez_compressed(tmp, **arrays)
+    tmp.replace(out / f"shard{k:04d}.npz")  # whole or not at all
+
+
+def _valid_shard(path: Path, seed: int, k: int) -> bool:
+    if not path.exists():
+        return False
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return int(z["format_version"][0]) == VERSION and z["seed"].tolist() == [seed, k]
+    except (OSError, ValueError, KeyError):
+        return False  # cut or foreign: rebuild it
+
+
+def load(folder: str | Path, log: Callable[[str], None] | None = None) -> dict[str, np.ndarray]:
+    """All shards of a built folder, verified against its manifest."""
+    folder = Path(folder)
+    path = folder / "manifest.json"
+    try:
+        manifest = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise DataFileError(f"{path}: cannot read ({e}); build with `vcc argpred data`") from None
+    if not isinstance(manifest, dict) or manifest.get("format") != FORMAT or manifest.get("version") != VERSION:
+        raise DataFileError(f"{path}: not a {FORMAT} v{VERSION} manifest")
+    parts: dict[str, list] = {"inputs": [], "outputs": [], "labels": [], "programs": []}
+    for name, sha in sorted(manifest["shards"].items()):
+        p = folder / name
+        if not p.exists() or _sha(p) != sha:
+            raise DataFileError(f"{p}: missing, or its sha256 differs from the manifest")
+        with np.load(p, allow_pickle=False) as z:
+            for key in ("inputs", "outputs", "labels"):
+                parts[key].append(z[key])
+            parts["programs"] += bytes(z["programs"]).decode().split("\n")
+    return {"inputs": np.concatenate(parts["inputs"]), "outputs": np.concatenate(parts["outputs"]),
+            "labels": np.concatenate(parts["labels"]), "programs": np.array(parts["programs"])}

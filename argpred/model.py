@@ -1,0 +1,35 @@
+"""The argument CNN (paper, "Argument prediction"): a convolution over each example's
+(21, 15, 15) features, max-pooled over positions, summed over the examples, one
+sigmoid per (function, argument) label. Summing over examples lets every example
+vote: an argument several examples show is more certain.
+
+`hidden=0` is the paper's single convolution (straight to the labels); `hidden>0`
+puts a ReLU convolution of that many channels before it (see `docs/argpred.md` for
+what each gives).
+"""
+
+from __future__ import annotations
+
+import flax.linen as nn
+import jax
+import jax.numpy as jnp
+
+from argpred.data import LABELS
+
+
+class ArgNet(nn.Module):
+    hidden: int = 32
+    kernel: int = 3
+
+    @nn.compact
+    def __call__(self, x: jax.Array, mask: jax.Array) -> jax.Array:
+        """x (B, E, 21, 15, 15), mask (B, E) of real examples -> logits (B, labels)."""
+        h = jnp.moveaxis(x.astype(jnp.float32), -3, -1)  # channels last
+        if self.hidden:
+            h = nn.relu(nn.Conv(self.hidden, (self.kernel, self.kernel), name="conv_hidden")(h))
+            h = nn.Conv(len(LABELS), (1, 1), use_bias=False, name="conv_out")(h)
+        else:
+            h = nn.Conv(len(LABELS), (self.kernel, self.kernel), use_bias=False, name="conv_out")(h)
+        pooled = h.max(axis=(-3, -2))  # (B, E, labels)
+        bias = self.param("bias", nn.initializers.zeros, (len(LABELS),))
+        return (pooled * mask[..., None]).sum(axis=1) + bias

@@ -1,0 +1,46 @@
+"""How well the predictor serves the search on the 546 concepts (their training pairs
+only; no concept is used in training): a concept is recalled when every argument its
+reference program gives a predicted function passes 0.55 (the search then can find
+it); extra arguments are those that pass though the reference does not use them
+(each one widens the search)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from argpred.data import PREDICTED
+from argpred.predict import Predictor, passing
+from vccjax.concepts import reference_program
+from vccjax.instructions import NAMES, arg_domain
+from vccjax.scene import Scene
+
+
+def used_arguments(concept: str) -> dict[str, set[str]]:
+    p = reference_program(concept)
+    used: dict[str, set[str]] = {f: set() for f in PREDICTED}
+    for o, a in zip(p.ops, p.args):
+        if NAMES[o] in PREDICTED:
+            used[NAMES[o]].add(arg_domain(NAMES[o])[a])
+    return used
+
+
+def recall(predictor: Predictor, concepts: Sequence[str],
+           pairs: Callable[[str], list[tuple[Scene, Scene]]]) -> dict:
+    missed: dict[str, dict[str, list[str]]] = {}
+    extra = {f: [] for f in PREDICTED}
+    for c in concepts:
+        ok = passing(predictor.for_pairs(pairs(c)))
+        used = used_arguments(c)
+        miss = {f: sorted(used[f] - set(ok[f])) for f in PREDICTED if used[f] - set(ok[f])}
+        if miss:
+            missed[c] = miss
+        for f in PREDICTED:
+            extra[f].append(len(set(ok[f]) - used[f]))
+    return {
+        "concepts": len(concepts), "recalled": len(concepts) - len(missed),
+        "recall": (len(concepts) - len(missed)) / len(concepts),
+        "mean_extra_arguments": {f: float(np.mean(v)) for f, v in extra.items()},
+        "missed": missed,
+    }

@@ -1,0 +1,133 @@
+"""Training the argument CNN with optax: Adam on the mean binary cross-entropy of the
+labels plus an L1 penalty on the convolution kernels (the paper's regulariser).
+
+Seeded throughout (initialisation, the validation split, each epoch's order), and
+checkpointed after every epoch (msgpack: epoch, parameters, optimiser state), so an
+interrupted run resumes and ends with the same weights as an uninterrupted one (and a
+finished run can be continued for more epochs).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from collections.abc import Callable
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import optax
+from flax import serialization
+
+from argpred.features import features_from_cells
+from argpred.model import ArgNet
+from argpred.weights import init_params
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainSettings:
+    hidden: int = 32
+    kernel: int = 3
+    epochs: int = 30
+    batch: int = 64
+    learning_rate: float = 3e-3
+    l1: float = 1e-4  # on the sum of |kernel weights|
+    validation: float = 0.1  # share of programs held out
+    seed: int = 0
+
+
+def _l1(params) -> jax.Array:
+    return sum(jnp.abs(w).sum() for path, w in jax.tree_util.tree_leaves_with_path(params)
+               if "kernel" in jax.tree_util.keystr(path))
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1))
+def _step(model: ArgNet, tx: optax.GradientTransformation, l1: float, params, opt_state, x, y):
+    def loss_fn(p):
+        logits = model.apply({"params": p}, x, jnp.ones(x.shape[:2]))
+        bce = optax.sigmoid_binary_cross_entropy(logits, y).mean()
+        return bce + l1 * _l1(p), bce
+
+    (_, bce), grads = jax.value_and_grad(loss_fn, has_aux=True)(params)
+    updates, opt_state = tx.update(grads, opt_state, params)
+    return optax.apply_updates(params, updates), opt_state, bce
+
+
+@functools.partial(jax.jit, static_argnums=0)
+def _eval(model: ArgNet, params, x, y):
+    logits = model.apply({"params": params}, x, jnp.ones(x.shape[:2]))
+    return optax.sigmoid_binary_cross_entropy(logits, y).mean(), jax.nn.sigmoid(logits)
+
+
+def split(n: int, settings: TrainSettings) -> tuple[np.ndarray, np.ndarray]:
+    order = np.random.default_rng([settings.seed, 1]).permutation(n)
+    k = int(round(n * settings.validation))
+    return np.sort(order[k:]), np.sort(order[:k])
+
+
+def batches(data: dict, idx: np.ndarray, size: int):
+    for s in range(0, len(idx), size):
+        b = idx[s : s + size]
+        yield features_from_cells(data["inputs"][b], data["outputs"][b]), data["labels"][b].astype(np.float32)
+
+
+def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = None,
+          progress: bool = True, log: Callable[[str], None] = print) -> tuple[ArgNet, dict, list[dict]]:
+    """Train on `data` (argpred.data.load); returns (model, params, per-epoch history)."""
+    from tqdm import tqdm
+
+    model = ArgNet(hidden=settings.hidden, kernel=settings.kernel)
+    tx = optax.adam(settings.learning_rate)
+    params = init_params(model, settings.seed)
+    opt_state = tx.init(params)
+    history: list[dict] = []
+    start = 0
+    ckpt = Path(checkpoint) if checkpoint else None
+    if ckpt and ckpt.exists():
+        try:
+            state = serialization.msgpack_restore(ckpt.read_bytes())
+            if state.get("settings") != _settings_dict(settings):
+                raise ValueError(f"{ckpt}: a checkpoint of other settings; remove it or use the same ones")
+            params = serialization.from_state_dict(params, state["params"])
+            opt_state = serialization.from_state_dict(opt_state, state["opt_state"])
+        except (KeyError, TypeError, AttributeError) as e:
+            raise ValueError(f"{ckpt}: not a checkpoint of this model ({e}); remove it") from None
+        start = int(state["epoch"])
+        history = [state["history"][k] for k in sorted(state["history"], key=int)]
+        log(f"resuming after epoch {start}")
+    tr, va = split(len(data["labels"]), settings)
+    bar = tqdm(range(start, settings.epochs), desc="argpred train", unit="epoch", disable=not progress)
+    for epoch in bar:
+        order = tr[np.random.default_rng([settings.seed, 2, epoch]).permutation(len(tr))]
+        losses = []
+        for x, y in batches(data, order, settings.batch):
+            params, opt_state, bce = _step(model, tx, settings.l1, params, opt_state, jnp.asarray(x), jnp.asarray(y))
+            losses.append(float(bce))
+        val = evaluate(model, params, data, va, settings.batch) if len(va) else {}
+        history.append({"epoch": epoch + 1, "train_bce": float(np.mean(losses)), **val})
+        bar.set_postfix(train=f"{history[-1]['train_bce']:.4f}", val=f"{val.get('val_bce', float('nan')):.4f}")
+        if ckpt:
+            ckpt.parent.mkdir(parents=True, exist_ok=True)
+            tmp = ckpt.with_suffix(".tmp")
+            tmp.write_bytes(serialization.to_bytes({
+                "epoch": epoch + 1, "params": params, "opt_state": opt_state,
+                "history": {str(k): h for k, h in enumerate(history)}, "settings": _settings_dict(settings)}))
+            tmp.replace(ckpt)
+    return model, params, history
+
+
+def _settings_dict(settings: TrainSettings) -> dict:
+    """What a checkpoint must share with the run resuming it (more epochs may follow)."""
+    return {k: str(v) for k, v in dataclasses.asdict(settings).items() if k != "epochs"}
+
+
+def evaluate(model: ArgNet, params, data: dict, idx: np.ndarray, batch: int = 256) -> dict:
+    """Held-out BCE, and the share of programs whose labels are all right at 0.55."""
+    total, right, n = 0.0, 0, 0
+    for x, y in batches(data, idx, batch):
+        bce, p = _eval(model, params, jnp.asarray(x), jnp.asarray(y))
+        total += float(bce) * len(y)
+        right += int(np.all((np.asarray(p) >= 0.55) == (y > 0.5), axis=1).sum())
+        n += len(y)
+    return {"val_bce": total / n, "val_all_labels_right": right / n}
