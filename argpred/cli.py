@@ -32,7 +32,7 @@ def cmd_train(a: argparse.Namespace) -> int:
     argdata.build(folder, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
     data = argdata.load(folder)
     settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, epochs=a.epochs, batch=a.batch,
-                             learning_rate=a.lr, l1=a.l1, seed=a.seed)
+                             learning_rate=a.lr, l1=a.l1, positive_weight=a.positive_weight, seed=a.seed)
     out = Path(a.out)
     model, params, history = train(data, settings, checkpoint=out.with_suffix(".ckpt"), progress=not a.quiet)
     sha = save(out, model, params, {"settings": {k: getattr(settings, k) for k in settings.__dataclass_fields__},
@@ -70,7 +70,7 @@ def add_commands(sub) -> None:
     s = p.add_subparsers(dest="action", required=True, metavar="ACTION")
     d = s.add_parser("data", help="draw training programs and their examples (resumable, seeded)")
     d.add_argument("--out", required=True, help="data folder (an existing one is resumed)")
-    d.add_argument("--programs", type=int, default=3000, help="programs to draw (default 3000)")
+    d.add_argument("--programs", type=int, default=1000, help="programs to draw (default 1000)")
     d.add_argument("--seed", type=int, default=0)
     d.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")
     d.add_argument("--quiet", action="store_true")
@@ -83,11 +83,13 @@ def add_commands(sub) -> None:
                                  "shipped weights.")
     t.add_argument("--out", default="argpred-weights.msgpack", help="weights file (default argpred-weights.msgpack)")
     t.add_argument("--data", help=f"data folder (default {DEFAULT_DATA}/seedS-N)")
-    t.add_argument("--programs", type=int, default=3000, help="training programs (default 3000)")
+    t.add_argument("--programs", type=int, default=1000, help="training programs (default 1000)")
     t.add_argument("--epochs", type=int, default=30)
     t.add_argument("--batch", type=int, default=64)
     t.add_argument("--lr", type=float, default=3e-3, help="Adam learning rate")
     t.add_argument("--l1", type=float, default=1e-4, help="L1 weight on the kernels")
+    t.add_argument("--positive-weight", type=float, default=4.0,
+                   help="loss weight of a used argument (>1 favours recall over extra arguments)")
     t.add_argument("--hidden", type=int, default=32, help="hidden channels (0: the paper's single convolution)")
     t.add_argument("--kernel", type=int, default=3)
     t.add_argument("--seed", type=int, default=0)

@@ -3,13 +3,19 @@
 The paper enumerates every valid program up to length 6 (scene_parse included), keeps
 those that change their inputs and in which every instruction with its argument is
 indispensable, and makes 10 examples of each. Enumerating is some 10^7 programs here,
-most of them thrown away by the filters, so we draw programs instead: uniformly over
-the instructions and their arguments, a length uniform in 2..6, loop syntax enforced,
-and apply the same filters exactly:
-- valid: 10 input scenes of the training split on which it runs (no failure) and
-  changes the scene (`examples.make_pairs`, inputs drawn as for the concepts);
+most of them thrown away by the filters, so we draw programs and apply the filters:
+- valid: a program grows on 3 input scenes (drawn as for the concepts' training
+  split, a pointer in all or none), one (instruction, argument) step at a time, each
+  drawn uniformly among the steps that run on all three, keep loop syntax and change
+  what the machine holds, up to a length drawn uniformly in 3..6 (as the paper; 8 did not
+  recall more concepts: docs/argpred.md), then is cut after its last
+  step that changed a scene; its 10 examples are drawn afresh as for a concept
+  (`examples.make_pairs`): inputs on which it runs;
+- informative: every example's output differs from its input;
 - indispensable: deleting any one instruction (but scene_parse) makes it fail or
   changes some output; a deletion that breaks loop syntax counts as indispensable.
+  A drawn program with dispensable instructions is not thrown away: they are deleted
+  one at a time (outputs unchanged) until every one left is indispensable.
 No concept of the 546 is used. Programs are drawn in shards, each seeded by (seed,
 shard), and written as they finish, so a build resumes and gives the same bytes.
 """
@@ -37,7 +43,7 @@ PREDICTED: tuple[str, ...] = ("set_shape_attn", "set_color_attn", "fill_color")
 LABELS: tuple[tuple[str, str], ...] = tuple((f, v) for f in PREDICTED for v in arg_domain(f))
 FORMAT, VERSION = "vccjax-argpred-data", 1
 SHARD = 100  # programs per shard file
-LENGTHS = (3, 6)  # scene_parse and one instruction change no scene
+LENGTHS = (3, 6)  # scene_parse and one instruction change no scene; 6 as the paper (8: docs/argpred.md)
 _DRAWABLE = tuple(op for op in range(len(NAMES)) if op != OP["scene_parse"])
 
 
@@ -48,19 +54,20 @@ def labels_of(program: Program) -> np.ndarray:
 
 
 def grow(rng: np.random.Generator, scenes: list[Scene], length: int) -> Program | None:
-    """A program of `length` instructions that runs on every scene: scene_parse, then at
-    each step an instruction (and argument) drawn uniformly among those that neither fail
-    on any scene nor break loop syntax (None if the draw runs into a dead end)."""
+    """A program of at most `length` instructions that runs on every scene: scene_parse,
+    then at each step an (instruction, argument) drawn uniformly among those that run on
+    every scene and change what some machine holds; cut after the last step that
+    changed a scene (later ones could only be dispensable). None if none did."""
     machines = [RefMachine(s, validate=False) for s in scenes]
     for m in machines:
         m.step(OP["scene_parse"])
-    ops, args = [OP["scene_parse"]], [0]
+    ops, args, ends = [OP["scene_parse"]], [0], []
     steps = [(o, a) for o in _DRAWABLE for a in range(max(1, len(arg_domain(NAMES[o]))))]
     while len(ops) < length:
         for k in rng.permutation(len(steps)):
             op, arg = steps[k]
             try:
-                check_loop_syntax(Program((*ops, op), (*args, arg)), complete=len(ops) + 1 == length)
+                check_loop_syntax(Program((*ops, op), (*args, arg)), complete=False)
             except ProgramSyntaxError:
                 continue
             trial = [m.clone() for m in machines]
@@ -71,30 +78,58 @@ def grow(rng: np.random.Generator, scenes: list[Scene], length: int) -> Program 
             if NAMES[op] not in ("loop_start", "loop_end") and not any(m.in_loop for m in trial) and all(
                     _signature(a) == _signature(b) for a, b in zip(machines, trial)):
                 continue  # changes nothing the machine shows: it could only be dispensable
+            if any(_scene(a) != _scene(b) for a, b in zip(machines, trial)):
+                ends.append(len(ops) + 1)
             machines, ops, args = trial, [*ops, op], [*args, arg]
             break
         else:
-            return None
-    return Program(tuple(ops), tuple(args))
+            break  # no step runs here
+    for end in reversed(ends):
+        program = Program(tuple(ops[:end]), tuple(args[:end]))
+        try:
+            check_loop_syntax(program)
+        except ProgramSyntaxError:
+            continue
+        return program
+    return None
+
+
+def _scene(m: RefMachine) -> tuple:
+    return tuple((o.x, o.y, o.color, o.alive) for o in m.objects)
 
 
 def _signature(m: RefMachine) -> tuple:
     """What a step can change that a later step can read (the fixation history aside)."""
-    return (tuple((o.x, o.y, o.color, o.alive) for o in m.objects), m.imagined, m.fovea, m.hand, m.held,
+    return (_scene(m), m.imagined, m.fovea, m.hand, m.held,
             m.shape_filter, m.color_filter, tuple(m.attended_list), m.stale, m.k, m.attended)
 
 
-def indispensable(program: Program, pairs) -> bool:
-    """Deleting any one instruction (but scene_parse) fails or changes some output."""
+def _deletions(program: Program):
+    """(index, program without that instruction) for each deletion that keeps loop syntax."""
     for i in range(1, len(program)):
         rival = Program(program.ops[:i] + program.ops[i + 1 :], program.args[:i] + program.args[i + 1 :])
         try:
             check_loop_syntax(rival)
         except ProgramSyntaxError:
             continue
-        if not any(distinguishes(rival, a, b) for a, b in pairs):
-            return False
-    return True
+        yield i, rival
+
+
+def indispensable(program: Program, pairs) -> bool:
+    """Deleting any one instruction (but scene_parse) fails or changes some output."""
+    return all(any(distinguishes(rival, a, b) for a, b in pairs) for _, rival in _deletions(program))
+
+
+def minimal(program: Program, pairs) -> Program:
+    """Delete dispensable instructions, last first, until every one left is
+    indispensable; the outputs on `pairs` stay the same at every deletion."""
+    while True:
+        for _, rival in reversed(list(_deletions(program))):
+            if not any(distinguishes(rival, a, b) for a, b in pairs):
+                program = rival
+                break
+        else:
+            return program
 
 
 def scene_pool(rng: np.random.Generator, size: int = 200) -> dict[bool, list[Scene]]:
@@ -115,7 +150,7 @@ def kept_program(rng: np.random.Generator, pool: dict[bool, list[Scene]],
     """Draw until a program passes the filters; (program, its 10 pairs). A program grows
     on `probes` pool scenes (half the draws with a pointer) and must change one of them;
     its 10 examples are then drawn afresh (`examples.make_pairs`: it runs on each input
-    and changes it), and every instruction must be indispensable on them."""
+    and changes it), and dispensable instructions are deleted (`minimal`)."""
     while True:
         scenes = pool[bool(rng.integers(2))]
         probe = [scenes[int(k)] for k in rng.choice(len(scenes), probes, replace=False)]
@@ -129,7 +164,8 @@ def kept_program(rng: np.random.Generator, pool: dict[bool, list[Scene]],
             pairs = make_pairs(program, TRAIN, rng, jitter=None, max_tries=max_tries)
         except ExampleError:
             continue
-        if indispensable(program, pairs):
+        program = minimal(program, pairs)
+        if len(program) >= LENGTHS[0]:
             return program, pairs
 
 
@@ -181,7 +217,7 @@ def build(out: str | Path, programs: int, seed: int = 0, workers: int = 1,
             _write_shard((out, seed, k))
             bar.update()
     bar.close()
-    manifest = {"format": FORMAT, "version": VERSION, "seed": seed, "shard": SHARD,
+    manifest = {"format": FORMAT, "version": VERSION, "seed": seed, "shard": SHARD, "lengths": list(LENGTHS),
                 "labels": [list(x) for x in LABELS], "max_objects": MAX_OBJECTS,
                 "shards": {f"shard{k:04d}.npz": _sha(out / f"shard{k:04d}.npz") for k in range(n)}}
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))

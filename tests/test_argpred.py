@@ -44,7 +44,7 @@ def test_drawn_programs_pass_the_filters_and_are_labelled():
     pool = argdata.scene_pool(rng, 40)
     for _ in range(5):
         program, pairs = argdata.kept_program(rng, pool)
-        assert len(pairs) == 10 and 3 <= len(program) <= 6
+        assert len(pairs) == 10 and argdata.LENGTHS[0] <= len(program) <= argdata.LENGTHS[1]
         assert argdata.indispensable(program, pairs)
         assert all(a != b for a, b in pairs)  # every example changes
     labels = argdata.labels_of(parse("scene_parse; set_color_attn(red); top_down_attend; fill_color(blue)"))
@@ -138,3 +138,32 @@ def test_predicted_arguments_keep_only_those_that_pass():
     assert lp["set_color_attn"][0] > lp["set_color_attn"][1]
     assert np.isinf(lp["fill_color"]).all()  # nothing passes: the instruction is left out
     assert lp["set_shape_attn"][0] == 0 and THRESHOLD == 0.55
+
+
+def test_shipped_weights_load_and_read_a_colour_change(capsys):
+    from vcc.cli import main
+
+    p = Predictor()  # the shipped weights, verified against their card
+    pairs = []
+    for k in range(10):
+        x = 0.15 + 0.07 * k
+        pairs.append((Scene((SceneObject("square", "red", x, 0.3, 0.1), SceneObject("circle", "green", x, 0.7, 0.1))),
+                      Scene((SceneObject("square", "blue", x, 0.3, 0.1), SceneObject("circle", "green", x, 0.7, 0.1)))))
+    probs = p.for_pairs(pairs)
+    assert probs["fill_color"][1:].argmax() + 1 == 2  # blue, of the colours not already there
+    assert probs["fill_color"][2] >= THRESHOLD
+    assert main(["argpred", "eval", "--concepts", "remove_bottom_obj,change_all_objs_color"]) == 0
+    out = capsys.readouterr().out.strip().splitlines()
+    assert out[-1].startswith("recall: ") and 0 <= float(out[-1].split()[1]) <= 1
+
+
+def test_induce_with_predicted_arguments(tmp_path, capsys, monkeypatch):
+    from vcc.cli import main
+
+    monkeypatch.setenv("VCCJAX_CACHE", "off")
+    out = tmp_path / "pred"
+    argv = ["induce", "--concepts", "change_target_obj_to_given_color,remove_bottom_obj", "--out", str(out),
+            "--budget", "20000", "--iterations", "1", "--args", "predicted+fixation", "--quiet"]
+    assert main(argv) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["found"] == 2 and summary["exact_on_all_test_pairs"] == 2
