@@ -130,17 +130,16 @@ class Run:
         mine = dataclasses.asdict(settings)
         if meta.exists():
             try:
-                theirs = json.loads(meta.read_text())
+                info = json.loads(meta.read_text())
             except json.JSONDecodeError as e:
                 raise DataFileError(f"{meta}: not JSON ({e})") from None
-            if theirs.get("settings") != mine:
+            if info.get("settings") != mine:
                 raise DataFileError(
-                    f"{meta}: this folder holds a run with other settings {theirs.get('settings')}; "
+                    f"{meta}: this folder holds a run with other settings {info.get('settings')}; "
                     "use another --out or the same settings to resume"
                 )
         else:
-            meta.write_text(json.dumps({"format": "vccjax-induce", "version": 1, "settings": mine}, indent=1))
-        info = json.loads(meta.read_text())
+            info = {"format": "vccjax-induce", "version": 1, "settings": mine}
         info.setdefault("sessions", []).append(round(time.time(), 3))  # starts, for the wall time
         self.session = len(info["sessions"]) - 1
         self._write_meta(info)
