@@ -105,26 +105,26 @@ def _signature(m: RefMachine) -> tuple:
 
 
 def _deletions(program: Program):
-    """(index, program without that instruction) for each deletion that keeps loop syntax."""
+    """The program without each one instruction (but scene_parse), where loop syntax holds."""
     for i in range(1, len(program)):
         rival = Program(program.ops[:i] + program.ops[i + 1 :], program.args[:i] + program.args[i + 1 :])
         try:
             check_loop_syntax(rival)
         except ProgramSyntaxError:
             continue
-        yield i, rival
+        yield rival
 
 
 def indispensable(program: Program, pairs) -> bool:
     """Deleting any one instruction (but scene_parse) fails or changes some output."""
-    return all(any(distinguishes(rival, a, b) for a, b in pairs) for _, rival in _deletions(program))
+    return all(any(distinguishes(rival, a, b) for a, b in pairs) for rival in _deletions(program))
 
 
 def minimal(program: Program, pairs) -> Program:
     """Delete dispensable instructions, last first, until every one left is
     indispensable; the outputs on `pairs` stay the same at every deletion."""
     while True:
-        for _, rival in reversed(list(_deletions(program))):
+        for rival in reversed(list(_deletions(program))):
             if not any(distinguishes(rival, a, b) for a, b in pairs):
                 program = rival
                 break
