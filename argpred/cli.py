@@ -45,7 +45,7 @@ def cmd_train(a: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_eval(a: argparse.Namespace) -> int:
+def cmd_recall(a: argparse.Namespace) -> int:
     from argpred.predict import Predictor
     from argpred.recall import recall
     from vccjax.concepts import concept_names
@@ -103,4 +103,4 @@ def add_commands(sub) -> None:
     e.add_argument("--dataset", help="dataset folder (default: the shipped one)")
     e.add_argument("--json", help="also write the full report here")
     e.add_argument("--show", type=int, default=10, help="missed concepts to list (default 10)")
-    e.set_defaults(fn=cmd_eval)
+    e.set_defaults(fn=cmd_recall)

@@ -22,6 +22,7 @@ from flax import serialization
 
 from argpred.features import features_from_cells
 from argpred.model import ArgNet
+from argpred.predict import THRESHOLD
 from argpred.weights import init_params
 
 
@@ -57,7 +58,7 @@ def _step(model: ArgNet, tx: optax.GradientTransformation, l1: float, pos: float
 
 
 @functools.partial(jax.jit, static_argnums=0)
-def _eval(model: ArgNet, params, x, y):
+def _held_out(model: ArgNet, params, x, y):
     logits = model.apply({"params": params}, x, jnp.ones(x.shape[:2]))
     return optax.sigmoid_binary_cross_entropy(logits, y).mean(), jax.nn.sigmoid(logits)
 
@@ -125,11 +126,11 @@ def _settings_dict(settings: TrainSettings) -> dict:
 
 
 def evaluate(model: ArgNet, params, data: dict, idx: np.ndarray, batch: int = 256) -> dict:
-    """Held-out BCE, and the share of programs whose labels are all right at 0.55."""
+    """Held-out BCE, and the share of programs whose labels are all right at the threshold."""
     total, right, n = 0.0, 0, 0
     for x, y in batches(data, idx, batch):
-        bce, p = _eval(model, params, jnp.asarray(x), jnp.asarray(y))
+        bce, p = _held_out(model, params, jnp.asarray(x), jnp.asarray(y))
         total += float(bce) * len(y)
-        right += int(np.all((np.asarray(p) >= 0.55) == (y > 0.5), axis=1).sum())
+        right += int(np.all((np.asarray(p) >= THRESHOLD) == (y > 0.5), axis=1).sum())
         n += len(y)
     return {"val_bce": total / n, "val_all_labels_right": right / n}
