@@ -58,8 +58,8 @@ def cmd_induce(a: argparse.Namespace) -> int:
     for it, k in s["per_iteration"].items():
         print(f"{'  new in iteration ' + str(it):<28}{k}")
     print(f"{'  without subroutines':<28}{s['found_without_subroutines']}")
-    print(f"{'wall time (s)':<28}{s['wall_seconds']} (all sessions of this run)")
-    print(f"{'search time (s)':<28}{s['search_seconds']} (+{s['compile_seconds']} compiling)")
+    print(f"{'wall time (s)':<28}{s['wall_seconds']:.1f} (all sessions of this run)")
+    print(f"{'search time (s)':<28}{s['search_seconds']:.1f} (+{s['compile_seconds']:.1f} compiling)")
     print(f"{'programs searched':<28}{s['programs_covered']} ({s['programs_run']} run, rest pruned)")
     print(f"throughput: {s['programs_per_second']} programs/s searched, "
           f"{s['programs_run_per_second']} programs/s run on all examples")
