@@ -11,7 +11,7 @@ from vccjax.concepts import concept_names, reference_program
 from vccjax.config import DEFAULT_CONFIG as CFG
 from vccjax.dataset import Dataset, build_dataset, read_npz, shipped_folder, write_npz
 from vccjax.errors import DataFileError
-from vccjax.examples import TEST, TRAIN, Jitter, distinguishes, is_well_posed, uses_pointer
+from vccjax.examples import TEST, TRAIN, TRAIN_WIDE, Jitter, distinguishes, is_well_posed, uses_pointer
 from vccjax.program import parse
 from vccjax.reference import RefMachine
 from vccjax.rivals import rival_programs
@@ -59,6 +59,20 @@ def test_every_13th_concept_gets_10_train_and_50_test_pairs(tmp_path):
     shipped = Dataset(shipped_folder())
     assert {n: shipped.sha256(n) for n in names} == {n: ds.sha256(n) for n in names}
     assert sorted(shipped.concepts) == sorted(concept_names())
+
+
+def test_a_rival_train_scenes_cannot_tell_apart_is_told_on_the_wider_range():
+    """Three objects stacked at a wall are well posed only with the test range's width
+    contrast; without such a pair, a program that stacks two and stops passed training."""
+    ds = Dataset(shipped_folder())
+    name = "stack_object_lower_left_corner_vertically"
+    assert ds.rivals_left(name) == []
+    rival = dict((label, p) for label, p in rival_programs(reference_program(name)))["loop as 2 straight passes"]
+    witnesses = [a for a, b in ds.pairs(name, "train") if distinguishes(rival, a, b, CFG, Jitter().slack)]
+    assert witnesses and all(len(a.objects) >= 3 for a in witnesses)
+    lo, hi = TRAIN_WIDE.widths
+    assert all(lo <= o.width <= hi for a in witnesses for o in a.objects)
+    assert any(not TRAIN.widths[0] <= o.width <= TRAIN.widths[1] for a in witnesses for o in a.objects)
 
 
 def test_an_example_that_hinges_on_a_hair_is_not_well_posed():

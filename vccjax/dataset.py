@@ -26,16 +26,17 @@ import numpy as np
 from vccjax.concepts import concept_names, reference_program
 from vccjax.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import DataFileError, read_json
-from vccjax.examples import TEST, TRAIN, ExampleError, discriminate, make_pairs
+from vccjax.examples import TEST, TRAIN, TRAIN_WIDE, WIDE_PATIENCE, ExampleError, discriminate, make_pairs
 from vccjax.instructions import COLORS, SHAPES
 from vccjax.rivals import rival_programs
 from vccjax.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
-VERSION = 7  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
+VERSION = 8  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
 # 4: drawn shapes kept apart (generate.drawn_cover), whole-scene and pointer nudges; 5: each object nudged alone;
 # 6: training pairs tell the reference from its rivals (rivals.py); rivals left untold are listed per concept;
-# 7: every loop of a program (not only the first) gets the straight-pass rivals
+# 7: every loop of a program (not only the first) gets the straight-pass rivals;
+# 8: rivals TRAIN's scenes leave untold get a second chance on the test's wider range (TRAIN_WIDE)
 _FIELDS = 6  # alive, shape, color, x, y, width
 
 
@@ -128,7 +129,10 @@ def build_concept(name: str, index: int, seed: int, cfg: VCCConfig) -> dict[str,
         pairs = make_pairs(program, spec, rng, cfg)
         if split == "train":
             rivals = rival_programs(program)
-            pairs, left = discriminate(program, pairs, [r for _, r in rivals], spec, rng, cfg)
+            programs = [r for _, r in rivals]
+            pairs, left = discriminate(program, pairs, programs, spec, rng, cfg)
+            if left:  # a second chance on the test's wider scenes (examples.TRAIN_WIDE)
+                pairs, left = discriminate(program, pairs, programs, TRAIN_WIDE, rng, cfg, patience=WIDE_PATIENCE)
             arrays["train_rivals_left"] = _text("\n".join(rivals[i][0] for i in left))
         for side, scenes in (("in", [p[0] for p in pairs]), ("out", [p[1] for p in pairs])):
             objs, ptr = scenes_to_arrays(scenes, cfg.n_max)
@@ -193,7 +197,7 @@ def build_dataset(
     manifest = {
         "format": FORMAT, "version": VERSION, "seed": seed,
         "config": {"raster": cfg.raster, "n_max": cfg.n_max},
-        "splits": {"train": vars_of(TRAIN), "test": vars_of(TEST)},
+        "splits": {"train": vars_of(TRAIN), "train_wide": vars_of(TRAIN_WIDE), "test": vars_of(TEST)},
         "concepts": {n: {"file": f"c{names.index(n):03d}.npz", "sha256": h} for n, h, err, _ in results if not err},
         "failed": {n: err for n, _, err, _ in results if err},
         "rivals_left": {n: left for n, _, err, left in results if left and not err},
