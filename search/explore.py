@@ -179,6 +179,7 @@ class Explorer:
         self.compile_seconds = 0.0  # first calls of each (op, size): compile time, kept apart
         self._bank: tuple[SceneConst, Target] | None = None
         self._slot: dict[int, int] = {}  # id(task) -> bank slot
+        self._room: np.ndarray | None = None  # see `_buffer`
 
     # ---- the bank of concepts' scenes ----------------------------------------------------
     def _load(self, slot: int, task: Task) -> None:
@@ -194,30 +195,44 @@ class Explorer:
         self._slot[id(task)] = slot
 
     # ---- device stepping ------------------------------------------------------------
-    def _pieces_of(self, key, rows: np.ndarray, call):
-        """Run `call(at)` over `rows` in bucket-sized pieces (each padded by repeating its
-        first row; `at(a)` gives a host array's rows of the piece), yielding (rows of the
-        piece, outputs without the padding); first calls of a (key, size) are timed as
-        compile time."""
-        start = 0
+    def _dispatch(self, key, rows: np.ndarray, call) -> list:
+        """Start `call(at)` over `rows` in bucket-sized pieces (each padded by repeating its
+        first row; `at(a)` gives a host array's rows of the piece) without waiting for the
+        results: JAX runs them while the host prepares the next. First calls of a
+        (key, size) compile synchronously and are timed as compile time. Returns
+        [(rows of the piece, device outputs with the padding)], for `_collect`."""
+        start, pending = 0, []
         for size in self._pieces(len(rows)):
             idx = rows[start : start + size]
             pad = np.concatenate([idx, np.full(size - len(idx), idx[0])])
             first = (key, size) not in self._compiled
             t0 = time.perf_counter()
-            out = jax.tree.map(lambda a: np.asarray(a)[: len(idx)], call(self._rows_of(pad)))  # noqa: B023
+            pending.append((idx, call(self._rows_of(pad))))
             if first:
+                jax.block_until_ready(pending[-1][1])
                 self._compiled.add((key, size))
                 self.compile_seconds += time.perf_counter() - t0
-            yield idx, out
             start += size
+        return pending
 
-    def _rows_of(self, pad: np.ndarray) -> Callable[[np.ndarray], object]:
-        """What `call` gets: `at(a)`, the padded rows of a host array, split over the devices
-        by rows when there are several (XLA then runs each device's share)."""
-        if len(self.devices) == 1:
-            return lambda a: a[pad]
-        return lambda a: jax.device_put(a[pad], self._rows)
+    @staticmethod
+    def _collect(pending: list):
+        """(rows, host outputs without the padding) of dispatched pieces, waiting for each."""
+        for idx, out in pending:
+            yield idx, jax.tree.map(lambda a: np.asarray(a)[: len(idx)], out)  # noqa: B023
+
+    def _pieces_of(self, key, rows: np.ndarray, call):
+        """`_dispatch` and `_collect` at once."""
+        return self._collect(self._dispatch(key, rows, call))
+
+    def _rows_of(self, pad: np.ndarray) -> Callable[..., object]:
+        """What `call` gets: `at(a)`, the padded rows of a host array (`at(a, via)`: rows
+        `via[pad]` of it), split over the devices by rows when there are several (XLA then
+        runs each device's share)."""
+        def at(a: np.ndarray, via: np.ndarray | None = None):
+            rows = a[pad if via is None else via[pad]]
+            return rows if len(self.devices) == 1 else jax.device_put(rows, self._rows)
+        return at
 
     def _pieces(self, n: int) -> list[int]:
         """Bucket sizes covering n rows at the least cost, counting each call as
@@ -227,28 +242,28 @@ class Explorer:
         full, rest = divmod(n, big)
         return [big] * full + (list(_cover(rest, self.buckets)) if rest else [])
 
-    def _holding_parts(self, op: int, states, rows: np.ndarray) -> list[np.ndarray]:
-        """`rows` split into those where some example holds an object and the rest, for a
-        carry op (the rest then skip the carry: `emulator.EMPTY_HANDED`)."""
+    def _holding_parts(self, op: int, held: np.ndarray, rows: np.ndarray) -> list[np.ndarray]:
+        """`rows` split into those where some example holds an object (`held`: (rows, E), the
+        held slot, -1 for none) and the rest, for a carry op (the rest then skip the
+        carry: `emulator.EMPTY_HANDED`)."""
         if op not in EMPTY_HANDED:
             return [rows]
-        holding = (packed_field(states, "held", self.cfg)[rows] >= 0).any(axis=1)
+        holding = (held >= 0).any(axis=1)
         return [part for part in (rows[holding], rows[~holding]) if len(part)]
 
-    def _step_rows(self, op: int, tids: np.ndarray, states, rows: np.ndarray, args: np.ndarray,
-                   failed: np.ndarray) -> None:
-        """Step `states[rows]` (packed, (n, E, P), in place) by `op`; mark the failures."""
+    def _dispatch_step(self, op: int, tids: np.ndarray, source, src: np.ndarray, rows: np.ndarray,
+                       args: np.ndarray) -> list:
+        """Start stepping rows `rows` of the batch by `op`, row i's state being
+        `source[src[i]]` (packed, (n, E, P)); see `_dispatch`."""
         cfg, (consts, _) = self.cfg, self._bank
-        loop_end = op == OP["loop_end"]
-        for part in self._holding_parts(op, states, rows):
-            for idx, (new, f) in self._pieces_of(
-                    ("step", op, states.shape[1]), part,
-                    lambda at: advance(cfg, op, consts, at(tids), at(states), at(args), not loop_end)):
-                states[idx] = new
-                failed[idx] |= f
-        if loop_end:
-            self._replay(tids, states, rows)
-            failed[rows] |= packed_field(states, "failed", cfg)[rows].any(axis=1)
+        replay_here = op != OP["loop_end"]  # a closed loop's further iterations: `_replay`
+        held = packed_field(source, "held", cfg) if op in EMPTY_HANDED else None
+        pending = []
+        for part in self._holding_parts(op, held[src[rows]] if held is not None else None, rows):
+            pending += self._dispatch(
+                ("step", op, source.shape[1]), part,
+                lambda at: advance(cfg, op, consts, at(tids), at(source, src), at(args), replay_here))
+        return pending
 
     def _replay(self, tids: np.ndarray, states, rows: np.ndarray) -> None:
         """A closed loop's remaining iterations for `states[rows]`, one body instruction at a
@@ -261,7 +276,7 @@ class Explorer:
         arg_j, pc_j = np.zeros(len(states), np.int32), np.zeros(len(states), np.int32)  # read at `rows` only
         iteration = 1
         while True:
-            active[rows] = loop_needs_iteration(cfg, unpack_state(states, cfg), iteration)[rows]  # host
+            active[rows] = loop_needs_iteration(cfg, unpack_state(states[rows], cfg), iteration)  # host
             rows_any = active[rows].any(axis=1)
             if not rows_any.any():
                 return
@@ -270,7 +285,8 @@ class Explorer:
                 for op in np.unique(ops[live, j]):
                     local = np.nonzero(live & (ops[:, j] == op))[0]
                     arg_j[rows[local]], pc_j[rows[local]] = args[local, j], pc0[local] + j
-                    for part in self._holding_parts(int(op), states, rows[local]):
+                    held = packed_field(states, "held", cfg)[rows[local]]
+                    for part in self._holding_parts(int(op), held, rows[local]):
                         self._replay_rows(tids, states, int(op), part, arg_j, pc_j, active)
             iteration += 1
 
@@ -311,22 +327,37 @@ class Explorer:
         sizes = [len(r.portions) for r in requests]
         bounds = np.cumsum([0] + sizes)
         owner = np.repeat(np.arange(len(requests)), sizes)
-        first = requests[0].states
-        states = np.empty((bounds[-1],) + first.shape[1:], first.dtype)
-        for r, a, b in zip(requests, bounds[:-1], bounds[1:]):
-            np.take(r.states, r.parents, axis=0, out=states[a:b])  # one copy: parents to the batch
+        # the parents the children start from, each once (a frame's parent has many children
+        # spread over many rounds: copying a state per child would copy it many times)
+        used, where, base = [], [], 0
+        for r in requests:
+            u, inv = np.unique(r.parents, return_inverse=True)
+            used.append(r.states[u])
+            where.append(inv.reshape(-1) + base)
+            base += len(u)
+        parents, parent_of = np.concatenate(used), np.concatenate(where)
+        n, e = len(owner), parents.shape[1]
+        states = self._buffer((n,) + parents.shape[1:], parents.dtype)  # the children's, filled column by column
         tids = np.array([self._slot[id(r.task)] for r in requests], np.int32)[owner]
         width = max(r.chain.op_mat.shape[1] for r in requests)
         pad = lambda m: np.pad(m, ((0, 0), (0, width - m.shape[1])), constant_values=-1)  # noqa: E731
         op_rows = np.concatenate([pad(r.chain.op_mat[r.portions]) for r in requests])  # (n, atoms), -1 padded
         arg_rows = np.maximum(np.concatenate([pad(r.chain.arg_mat[r.portions]) for r in requests]), 0)
-        n = len(owner)
-        e = states.shape[1]
         failed = np.zeros(n, bool)
-        for k in range(width):
+        for k in range(width):  # column k of the portions: every child's k-th atom (portions are -1 padded)
             ops, args = op_rows[:, k], np.ascontiguousarray(arg_rows[:, k])
-            for op in np.unique(ops[(ops >= 0) & ~failed]):
-                self._step_rows(int(op), tids, states, np.nonzero((ops == op) & ~failed)[0], args, failed)
+            source, src = (parents, parent_of) if k == 0 else (states, np.arange(n))
+            groups = {int(op): np.nonzero((ops == op) & ~failed)[0] for op in np.unique(ops[(ops >= 0) & ~failed])}
+            pending = [self._dispatch_step(op, tids, source, src, rows, args) for op, rows in groups.items()]
+            for piece in pending:  # every group started before any is waited for
+                for idx, (new, f) in self._collect(piece):
+                    states[idx] = new
+                    failed[idx] |= f
+            closed = groups.get(OP["loop_end"])
+            if closed is not None:
+                closed = closed[~failed[closed]]
+                self._replay(tids, states, closed)
+                failed[closed] |= packed_field(states, "failed", self.cfg)[closed].any(axis=1)
         verdicts = np.zeros((n, e), np.int32)
         judged = np.nonzero(np.concatenate([r.may_end for r in requests]) & ~failed)[0]
         if len(judged):
@@ -340,11 +371,20 @@ class Explorer:
             ok[i] = self._settle(requests[owner[i]].task, states, int(i), verdicts[i])
         return [(states[a:b], failed[a:b], ok[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
 
+    def _buffer(self, shape: tuple, dtype) -> np.ndarray:
+        """Room for a round's children, reused from round to round (a fresh array each round
+        cost as much in page faults as the copies into it). The DFS copies what it keeps
+        (`take`) before the next round, so nothing outlives the round."""
+        size = int(np.prod(shape))
+        if self._room is None or self._room.size < size or self._room.dtype != dtype:
+            self._room = np.empty(max(size, 2 * (0 if self._room is None else self._room.size)), dtype)
+        return self._room[:size].reshape(shape)
+
     def _settle(self, task: Task, states, i: int, v: np.ndarray) -> bool:
         """Rare: two same-looking objects within tau of one target; match on the host."""
         for e, (_, out) in enumerate(task.pairs):
             if v[e] == ASK:
-                c = jax.tree.map(lambda a: a[e], task.consts)
+                c = jax.tree.map(lambda a: a[e], task.consts)  # noqa: B023
                 s = unpack_state(states[i, e], self.cfg)
                 if not scenes_match(output_scene(c, s, self.cfg), out, self.cfg.tau):
                     return False
