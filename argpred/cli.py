@@ -31,7 +31,7 @@ def cmd_train(a: argparse.Namespace) -> int:
     start = time.time()
     argdata.build(folder, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
     data = argdata.load(folder)
-    settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, epochs=a.epochs, batch=a.batch,
+    settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, depth=a.depth, epochs=a.epochs, batch=a.batch,
                              learning_rate=a.lr, l1=a.l1, positive_weight=a.positive_weight, seed=a.seed)
     out = Path(a.out)
     model, params, history = train(data, settings, checkpoint=out.with_suffix(".ckpt"), progress=not a.quiet)
@@ -92,6 +92,7 @@ def add_commands(sub) -> None:
                    help="loss weight of a used argument (>1 favours recall over extra arguments)")
     t.add_argument("--hidden", type=int, default=32, help="hidden channels (0: the paper's single convolution)")
     t.add_argument("--kernel", type=int, default=3)
+    t.add_argument("--depth", type=int, default=1, help="hidden convolutions (with --hidden > 0)")
     t.add_argument("--seed", type=int, default=0)
     t.add_argument("--workers", type=int, default=0, help="processes for the data (default: one per core)")
     t.add_argument("--quiet", action="store_true")

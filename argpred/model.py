@@ -4,8 +4,9 @@ sigmoid per (function, argument) label. Summing over examples lets every example
 vote: an argument several examples show is more certain.
 
 `hidden=0` is the paper's single convolution (straight to the labels); `hidden>0`
-puts a ReLU convolution of that many channels before it (see `docs/argpred.md` for
-what each gives).
+puts `depth` ReLU convolutions of that many channels before it (see `docs/argpred.md`
+for what each gives). Two layers see 5x5 cells: an object and the cell a moved one
+lands on beside it.
 """
 
 from __future__ import annotations
@@ -20,13 +21,16 @@ from argpred.data import LABELS
 class ArgNet(nn.Module):
     hidden: int = 32
     kernel: int = 3
+    depth: int = 1  # hidden convolutions (when hidden > 0)
 
     @nn.compact
     def __call__(self, x: jax.Array, mask: jax.Array) -> jax.Array:
         """x (B, E, 21, 15, 15), mask (B, E) of real examples -> logits (B, labels)."""
         h = jnp.moveaxis(x.astype(jnp.float32), -3, -1)  # channels last
         if self.hidden:
-            h = nn.relu(nn.Conv(self.hidden, (self.kernel, self.kernel), name="conv_hidden")(h))
+            for k in range(self.depth):
+                name = "conv_hidden" if k == 0 else f"conv_hidden_{k + 1}"
+                h = nn.relu(nn.Conv(self.hidden, (self.kernel, self.kernel), name=name)(h))
             h = nn.Conv(len(LABELS), (1, 1), use_bias=False, name="conv_out")(h)
         else:
             h = nn.Conv(len(LABELS), (self.kernel, self.kernel), use_bias=False, name="conv_out")(h)

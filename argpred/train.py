@@ -30,6 +30,7 @@ from argpred.weights import init_params
 class TrainSettings:
     hidden: int = 32
     kernel: int = 3
+    depth: int = 1
     epochs: int = 30
     batch: int = 64
     learning_rate: float = 3e-3
@@ -80,7 +81,7 @@ def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = N
     """Train on `data` (argpred.data.load); returns (model, params, per-epoch history)."""
     from tqdm import tqdm
 
-    model = ArgNet(hidden=settings.hidden, kernel=settings.kernel)
+    model = ArgNet(hidden=settings.hidden, kernel=settings.kernel, depth=settings.depth)
     tx = optax.adam(settings.learning_rate)
     params = init_params(model, settings.seed)
     opt_state = tx.init(params)

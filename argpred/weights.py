@@ -37,7 +37,7 @@ def save(path: str | Path, model: ArgNet, params: dict, info: dict | None = None
     path.parent.mkdir(parents=True, exist_ok=True)
     data = serialization.to_bytes(jax.device_get(params))
     sha = hashlib.sha256(data).hexdigest()
-    card = {"format": FORMAT, "version": VERSION, "model": {"hidden": model.hidden, "kernel": model.kernel},
+    card = {"format": FORMAT, "version": VERSION, "model": {"hidden": model.hidden, "kernel": model.kernel, "depth": model.depth},
             "labels": [list(x) for x in LABELS], "sha256": sha, **(info or {})}
     tmp = path.with_suffix(".tmp")
     tmp.write_bytes(data)
@@ -64,7 +64,8 @@ def load(path: str | Path | None = None) -> tuple[ArgNet, dict, dict]:
     if hashlib.sha256(data).hexdigest() != card.get("sha256"):
         raise DataFileError(f"{path}: sha256 differs from its card (corrupt or replaced)")
     try:
-        model = ArgNet(hidden=int(card["model"]["hidden"]), kernel=int(card["model"]["kernel"]))
+        model = ArgNet(hidden=int(card["model"]["hidden"]), kernel=int(card["model"]["kernel"]),
+                       depth=int(card["model"].get("depth", 1)))
         params = serialization.from_bytes(init_params(model), data)
     except (KeyError, TypeError, ValueError) as e:
         raise DataFileError(f"{path}: does not hold this model's weights ({e})") from None

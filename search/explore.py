@@ -282,20 +282,21 @@ class Explorer:
                 return
             for j in range(int(length[rows_any].max())):
                 live = rows_any & (length > j)
+                pending = []  # the groups of body position j, all started before any is waited for
                 for op in np.unique(ops[live, j]):
                     local = np.nonzero(live & (ops[:, j] == op))[0]
                     arg_j[rows[local]], pc_j[rows[local]] = args[local, j], pc0[local] + j
                     held = packed_field(states, "held", cfg)[rows[local]]
                     for part in self._holding_parts(int(op), held, rows[local]):
-                        self._replay_rows(tids, states, int(op), part, arg_j, pc_j, active)
+                        pending += self._dispatch_replay(tids, states, int(op), part, arg_j, pc_j, active)
+                for idx, new in self._collect(pending):
+                    states[idx] = new
             iteration += 1
 
-    def _replay_rows(self, tids, states, op: int, rows: np.ndarray, args, pcs, active) -> None:
+    def _dispatch_replay(self, tids, states, op: int, rows: np.ndarray, args, pcs, active) -> list:
         cfg, (consts, _) = self.cfg, self._bank
-        for idx, new in self._pieces_of(
-                ("replay", op, active.shape[1]), rows,
-                lambda at: replay(cfg, op, consts, at(tids), at(states), at(args), at(pcs), at(active))):
-            states[idx] = new
+        return self._dispatch(("replay", op, active.shape[1]), rows,
+                              lambda at: replay(cfg, op, consts, at(tids), at(states), at(args), at(pcs), at(active)))
 
     # ---- the backend: what the DFS needs from a machine --------------------------------
     def root_states(self, task: Task):
