@@ -115,7 +115,7 @@ def test_weights_round_trip_and_refuse_corrupt_or_foreign_files(tiny, tmp_path):
     probs = p.probabilities(x[None])
     assert probs.shape == (1, len(argdata.LABELS)) and ((probs >= 0) & (probs <= 1)).all()
     m2, params2, card = load(path)
-    assert card["model"] == {"hidden": 4, "kernel": 3}
+    assert card["model"] == {"hidden": 4, "kernel": 3, "depth": 1}
     data = bytearray(path.read_bytes())
     data[len(data) // 2] ^= 0xFF
     path.write_bytes(bytes(data))
