@@ -242,13 +242,13 @@ class Explorer:
         full, rest = divmod(n, big)
         return [big] * full + (list(_cover(rest, self.buckets)) if rest else [])
 
-    def _holding_parts(self, op: int, held: np.ndarray, rows: np.ndarray) -> list[np.ndarray]:
-        """`rows` split into those where some example holds an object (`held`: (rows, E), the
-        held slot, -1 for none) and the rest, for a carry op (the rest then skip the
-        carry: `emulator.EMPTY_HANDED`)."""
+    def _holding_parts(self, op: int, source, at: np.ndarray, rows: np.ndarray) -> list[np.ndarray]:
+        """`rows` split into those where some example holds an object (their states are
+        `source[at]`) and the rest, for a carry op (the rest then skip the carry:
+        `emulator.EMPTY_HANDED`)."""
         if op not in EMPTY_HANDED:
             return [rows]
-        holding = (held >= 0).any(axis=1)
+        holding = (packed_field(source, "held", self.cfg)[at] >= 0).any(axis=1)
         return [part for part in (rows[holding], rows[~holding]) if len(part)]
 
     def _dispatch_step(self, op: int, tids: np.ndarray, source, src: np.ndarray, rows: np.ndarray,
@@ -257,9 +257,8 @@ class Explorer:
         `source[src[i]]` (packed, (n, E, P)); see `_dispatch`."""
         cfg, (consts, _) = self.cfg, self._bank
         replay_here = op != OP["loop_end"]  # a closed loop's further iterations: `_replay`
-        held = packed_field(source, "held", cfg) if op in EMPTY_HANDED else None
         pending = []
-        for part in self._holding_parts(op, held[src[rows]] if held is not None else None, rows):
+        for part in self._holding_parts(op, source, src[rows], rows):
             pending += self._dispatch(
                 ("step", op, source.shape[1]), part,
                 lambda at: advance(cfg, op, consts, at(tids), at(source, src), at(args), replay_here))
@@ -286,8 +285,7 @@ class Explorer:
                 for op in np.unique(ops[live, j]):
                     local = np.nonzero(live & (ops[:, j] == op))[0]
                     arg_j[rows[local]], pc_j[rows[local]] = args[local, j], pc0[local] + j
-                    held = packed_field(states, "held", cfg)[rows[local]]
-                    for part in self._holding_parts(int(op), held, rows[local]):
+                    for part in self._holding_parts(int(op), states, rows[local], rows[local]):
                         pending += self._dispatch_replay(tids, states, int(op), part, arg_j, pc_j, active)
                 for idx, new in self._collect(pending):
                     states[idx] = new
