@@ -14,7 +14,8 @@ def cmd_data(a: argparse.Namespace) -> int:
 
     from argpred.data import build
 
-    m = build(a.out, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
+    m = build(a.out, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet,
+              joined=a.joined)
     print(f"{len(m['shards'])} shards ({len(m['shards']) * m['shard']} programs) in {a.out}")
     return 0
 
@@ -23,14 +24,29 @@ def cmd_train(a: argparse.Namespace) -> int:
     import os
     import time
 
+    import numpy as np
+
     from argpred import data as argdata
     from argpred.train import TrainSettings, train
     from argpred.weights import save
 
-    folder = Path(a.data) if a.data else DEFAULT_DATA / f"seed{a.seed}-{a.programs}"
     start = time.time()
-    argdata.build(folder, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
-    data = argdata.load(folder)
+    folders = [f for f in (a.data or "").split(",") if f]
+    if len(folders) > 1:  # several built folders, trained on together (each verified, none redrawn)
+        missing = [f for f in folders if argdata.built(f) is None]
+        if missing:
+            raise ValueError(f"not a built data folder: {', '.join(missing)} (build with `vcc argpred data`)")
+        parts = [argdata.load(f) for f in folders]
+        data = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+    else:
+        have = argdata.built(folders[0]) if folders else None  # an existing folder keeps its count and draw
+        programs = a.programs or (have or {}).get("programs", 1000)
+        joined = a.joined if a.joined is not None else (have or {}).get("joined", 0.0)
+        tag = f"-joined{joined:g}" if joined else ""
+        folder = Path(folders[0]) if folders else DEFAULT_DATA / f"seed{a.seed}-{programs}{tag}"
+        argdata.build(folder, programs, seed=have["seed"] if have else a.seed,
+                      workers=a.workers or os.cpu_count() or 1, progress=not a.quiet, joined=joined)
+        data = argdata.load(folder)
     settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, depth=a.depth, epochs=a.epochs, batch=a.batch,
                              learning_rate=a.lr, l1=a.l1, positive_weight=a.positive_weight, seed=a.seed)
     out = Path(a.out)
@@ -72,6 +88,8 @@ def add_commands(sub) -> None:
     d.add_argument("--out", required=True, help="data folder (an existing one is resumed)")
     d.add_argument("--programs", type=int, default=1000, help="programs to draw (default 1000)")
     d.add_argument("--seed", type=int, default=0)
+    d.add_argument("--joined", type=float, default=0.0,
+                   help="share of programs drawn as two parts joined by reset_attn (default 0)")
     d.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")
     d.add_argument("--quiet", action="store_true")
     d.set_defaults(fn=cmd_data)
@@ -82,8 +100,10 @@ def add_commands(sub) -> None:
                                  "An interrupted run resumes from OUT.ckpt. The defaults reproduce the "
                                  "shipped weights.")
     t.add_argument("--out", default="argpred-weights.msgpack", help="weights file (default argpred-weights.msgpack)")
-    t.add_argument("--data", help=f"data folder (default {DEFAULT_DATA}/seedS-N)")
-    t.add_argument("--programs", type=int, default=1000, help="training programs (default 1000)")
+    t.add_argument("--data", help=f"data folder (default {DEFAULT_DATA}/seedS-N), or several built ones, "
+                                  "comma-separated, to train on together")
+    t.add_argument("--programs", type=int, default=None,
+                   help="training programs (default: all of an existing --data folder, else 1000)")
     t.add_argument("--epochs", type=int, default=30)
     t.add_argument("--batch", type=int, default=64)
     t.add_argument("--lr", type=float, default=3e-3, help="Adam learning rate")
@@ -91,6 +111,8 @@ def add_commands(sub) -> None:
     t.add_argument("--positive-weight", type=float, default=4.0,
                    help="loss weight of a used argument (>1 favours recall over extra arguments)")
     t.add_argument("--hidden", type=int, default=32, help="hidden channels (0: the paper's single convolution)")
+    t.add_argument("--joined", type=float, default=None,
+                   help="share of two-part programs in newly drawn data (default: the folder's, else 0)")
     t.add_argument("--kernel", type=int, default=3)
     t.add_argument("--depth", type=int, default=1, help="hidden convolutions (with --hidden > 0)")
     t.add_argument("--seed", type=int, default=0)

@@ -53,15 +53,19 @@ def labels_of(program: Program) -> np.ndarray:
     return np.array([lab in used for lab in LABELS], np.int8)
 
 
-def grow(rng: np.random.Generator, scenes: list[Scene], length: int) -> Program | None:
-    """A program of at most `length` instructions that runs on every scene: scene_parse,
-    then at each step an (instruction, argument) drawn uniformly among those that run on
-    every scene and change what some machine holds; cut after the last step that
-    changed a scene (later ones could only be dispensable). None if none did."""
+def grow(rng: np.random.Generator, scenes: list[Scene], length: int,
+         prefix: Program | None = None) -> Program | None:
+    """A program of at most `length` instructions that runs on every scene: scene_parse
+    (or `prefix`), then at each step an (instruction, argument) drawn uniformly among
+    those that run on every scene and change what some machine holds; cut after the
+    last step that changed a scene (later ones could only be dispensable). None if no
+    step after the prefix did."""
+    prefix = prefix or Program((OP["scene_parse"],), (0,))
     machines = [RefMachine(s, validate=False) for s in scenes]
     for m in machines:
-        m.step(OP["scene_parse"])
-    ops, args, ends = [OP["scene_parse"]], [0], []
+        for op, arg in zip(prefix.ops, prefix.args):
+            m.step(op, arg)
+    ops, args, ends = list(prefix.ops), list(prefix.args), []
     steps = [(o, a) for o in _DRAWABLE for a in range(max(1, len(arg_domain(NAMES[o]))))]
     while len(ops) < length:
         for k in rng.permutation(len(steps)):
@@ -145,8 +149,8 @@ def scene_pool(rng: np.random.Generator, size: int = 200) -> dict[bool, list[Sce
     return pool
 
 
-def kept_program(rng: np.random.Generator, pool: dict[bool, list[Scene]],
-                 probes: int = 3, max_tries: int = 60) -> tuple[Program, list[tuple[Scene, Scene]]]:
+def kept_program(rng: np.random.Generator, pool: dict[bool, list[Scene]], probes: int = 3, max_tries: int = 60,
+                 joined: float = 0.0) -> tuple[Program, list[tuple[Scene, Scene]]]:
     """Draw until a program passes the filters; (program, its 10 pairs). A program grows
     on `probes` pool scenes (half the draws with a pointer) and must change one of them;
     its 10 examples are then drawn afresh (`examples.make_pairs`: it runs on each input
@@ -157,6 +161,11 @@ def kept_program(rng: np.random.Generator, pool: dict[bool, list[Scene]],
         program = grow(rng, probe, int(rng.integers(LENGTHS[0], LENGTHS[1] + 1)))
         if program is None:
             continue
+        if joined and rng.random() < joined:  # a second part after reset_attn, as the concepts' "A and B"
+            first = Program((*program.ops, OP["reset_attn"]), (*program.args, 0))
+            program = grow(rng, probe, len(first) + int(rng.integers(LENGTHS[0] - 1, LENGTHS[1])), prefix=first)
+            if program is None:
+                continue
         outs = [RefMachine(s, validate=False).run(program).output_scene() for s in probe]
         if all(scenes_match(o, s, DEFAULT_CONFIG.tau) for o, s in zip(outs, probe)):
             continue  # changes nothing it was grown on
@@ -169,13 +178,16 @@ def kept_program(rng: np.random.Generator, pool: dict[bool, list[Scene]],
             return program, pairs
 
 
-def build_shard(seed: int, shard: int, size: int = SHARD) -> dict[str, np.ndarray]:
-    rng = np.random.default_rng([seed, shard, 0xA59])
+def build_shard(seed: int, shard: int, size: int = SHARD, joined: float = 0.0) -> dict[str, np.ndarray]:
+    """`joined`: the share of programs drawn as two parts joined by reset_attn (0 keeps
+    the draws of the shipped weights' data byte for byte)."""
+    key = [seed, shard, 0xA59] + ([int(round(joined * 1000))] if joined else [])
+    rng = np.random.default_rng(key)
     progs, ins, outs = [], [], []
     seen: set = set()
     pool = scene_pool(rng)
     while len(progs) < size:
-        program, pairs = kept_program(rng, pool)
+        program, pairs = kept_program(rng, pool, joined=joined)
         if (program.ops, program.args) in seen:
             continue
         seen.add((program.ops, program.args))
@@ -188,6 +200,7 @@ def build_shard(seed: int, shard: int, size: int = SHARD) -> dict[str, np.ndarra
         "programs": np.frombuffer(text.encode(), np.uint8),
         "inputs": np.stack(ins), "outputs": np.stack(outs),  # (P, 10, 9, 4) int8 cells
         "labels": np.stack([labels_of(p) for p in progs]),
+        **({"joined": np.array([joined])} if joined else {}),
     }
 
 
@@ -196,8 +209,9 @@ def _sha(path: Path) -> str:
 
 
 def build(out: str | Path, programs: int, seed: int = 0, workers: int = 1,
-          progress: bool = True) -> dict:
-    """Build (or resume) `programs` training programs (rounded up to shards) under `out`."""
+          progress: bool = True, joined: float = 0.0) -> dict:
+    """Build (or resume) `programs` training programs (rounded up to shards) under `out`.
+    A folder built with another seed or share of joined programs is refused, not rebuilt."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
@@ -206,38 +220,60 @@ def build(out: str | Path, programs: int, seed: int = 0, workers: int = 1,
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     n = -(-programs // SHARD)
-    todo = [k for k in range(n) if not _valid_shard(out / f"shard{k:04d}.npz", seed, k)]
+    if (out / "manifest.json").exists():
+        try:
+            old = json.loads((out / "manifest.json").read_text())
+            mine = (old["seed"], old.get("joined", 0.0))
+        except (ValueError, KeyError, TypeError) as e:
+            raise DataFileError(f"{out / 'manifest.json'}: not a manifest of this data ({e})") from None
+        if mine != (seed, joined):
+            raise DataFileError(f"{out}: built with seed {mine[0]} and joined {mine[1]}, asked for seed {seed} "
+                                f"and joined {joined}; use those or another folder")
+    todo = [k for k in range(n) if not _valid_shard(out / f"shard{k:04d}.npz", seed, k, joined)]
     bar = tqdm(total=n, initial=n - len(todo), desc="argpred data", unit="shard", disable=not progress)
     if workers > 1 and len(todo) > 1:
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-            for _ in pool.map(_write_shard, [(out, seed, k) for k in todo]):
+            for _ in pool.map(_write_shard, [(out, seed, k, joined) for k in todo]):
                 bar.update()
     else:
         for k in todo:
-            _write_shard((out, seed, k))
+            _write_shard((out, seed, k, joined))
             bar.update()
     bar.close()
-    manifest = {"format": FORMAT, "version": VERSION, "seed": seed, "shard": SHARD, "lengths": list(LENGTHS),
+    manifest = {"format": FORMAT, "version": VERSION, "seed": seed, "joined": joined, "shard": SHARD,
+                "lengths": list(LENGTHS),
                 "labels": [list(x) for x in LABELS], "max_objects": MAX_OBJECTS,
                 "shards": {f"shard{k:04d}.npz": _sha(out / f"shard{k:04d}.npz") for k in range(n)}}
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
     return manifest
 
 
+def built(folder: str | Path) -> dict | None:
+    """What a built folder's manifest says: programs, seed and joined share (None when
+    there is none), so that training on an existing folder keeps all of it as it is."""
+    try:
+        manifest = json.loads((Path(folder) / "manifest.json").read_text())
+        return {"programs": len(manifest["shards"]) * int(manifest["shard"]), "seed": int(manifest["seed"]),
+                "joined": float(manifest.get("joined", 0.0))}
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
 def _write_shard(job) -> None:
-    out, seed, k = job
-    arrays = build_shard(seed, k)
+    out, seed, k, joined = job
+    arrays = build_shard(seed, k, joined=joined)
     tmp = out / f"shard{k:04d}.tmp.npz"
     np.savez_compressed(tmp, **arrays)
     tmp.replace(out / f"shard{k:04d}.npz")  # whole or not at all
 
 
-def _valid_shard(path: Path, seed: int, k: int) -> bool:
+def _valid_shard(path: Path, seed: int, k: int, joined: float = 0.0) -> bool:
     if not path.exists():
         return False
     try:
         with np.load(path, allow_pickle=False) as z:
-            return int(z["format_version"][0]) == VERSION and z["seed"].tolist() == [seed, k]
+            share = float(z["joined"][0]) if "joined" in z.files else 0.0
+            return int(z["format_version"][0]) == VERSION and z["seed"].tolist() == [seed, k] and share == joined
     except (OSError, ValueError, KeyError):
         return False  # cut or foreign: rebuild it
 

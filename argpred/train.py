@@ -93,6 +93,8 @@ def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = N
             state = serialization.msgpack_restore(ckpt.read_bytes())
             if state.get("settings") != _settings_dict(settings):
                 raise ValueError(f"{ckpt}: a checkpoint of other settings; remove it or use the same ones")
+            if state.get("data") != data_fingerprint(data):
+                raise ValueError(f"{ckpt}: a checkpoint trained on other data; remove it or use the same data")
             params = serialization.from_state_dict(params, state["params"])
             opt_state = serialization.from_state_dict(opt_state, state["opt_state"])
         except (KeyError, TypeError, AttributeError) as e:
@@ -116,9 +118,20 @@ def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = N
             tmp = ckpt.with_suffix(".tmp")
             tmp.write_bytes(serialization.to_bytes({
                 "epoch": epoch + 1, "params": params, "opt_state": opt_state,
-                "history": {str(k): h for k, h in enumerate(history)}, "settings": _settings_dict(settings)}))
+                "history": {str(k): h for k, h in enumerate(history)}, "settings": _settings_dict(settings),
+                "data": data_fingerprint(data)}))
             tmp.replace(ckpt)
     return model, params, history
+
+
+def data_fingerprint(data: dict) -> str:
+    """sha256 of the training programs and labels: a checkpoint resumes only on the data it
+    was trained on (a folder grown from 1,000 to 3,000 programs is other data)."""
+    import hashlib
+
+    h = hashlib.sha256("\n".join(map(str, data["programs"])).encode())
+    h.update(np.ascontiguousarray(data["labels"]).tobytes())
+    return h.hexdigest()
 
 
 def _settings_dict(settings: TrainSettings) -> dict:

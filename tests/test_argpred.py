@@ -79,6 +79,10 @@ def test_shards_are_seeded_and_data_loads_verified(tiny):
     d = argdata.load(tiny)
     assert d["inputs"].shape == (24, 10, 9, 4) and d["labels"].shape == (24, len(argdata.LABELS))
     assert len(d["programs"]) == 24
+    assert argdata.built(tiny) == {"programs": 24, "seed": 5, "joined": 0.0}  # `train --data` keeps them all
+    assert argdata.built(tiny / "none") is None
+    with pytest.raises(DataFileError, match="built with seed 5 and joined 0"):
+        argdata.build(tiny, 24, seed=6)  # refused, not rebuilt: nothing drawn is lost
     (tiny / "extra").mkdir(exist_ok=True)
     bad = tiny / "extra"
     (bad / "manifest.json").write_text(json.dumps({"format": "something else"}))
@@ -96,6 +100,9 @@ def test_loss_falls_and_training_resumes_to_the_same_weights(tiny, tmp_path):
     train(d, TrainSettings(**{**settings.__dict__, "epochs": 3}), checkpoint=ckpt, progress=False)
     with pytest.raises(ValueError, match="other settings"):
         train(d, TrainSettings(**{**settings.__dict__, "epochs": 3, "l1": 0.5}), checkpoint=ckpt, progress=False)
+    fewer = {k: v[:20] for k, v in d.items()}
+    with pytest.raises(ValueError, match="other data"):
+        train(fewer, TrainSettings(**{**settings.__dict__, "epochs": 3}), checkpoint=ckpt, progress=False)
     import jax
 
     _, resumed, hist2 = train(d, settings, checkpoint=ckpt, progress=False, log=lambda s: None)

@@ -6,6 +6,7 @@ import argparse
 import sys
 
 from argpred import cli as argpred_cli
+from robot import cli as robot_cli
 from search import cli as search_cli
 from vcc import bench
 from vccjax import cli as vccjax_cli
@@ -21,6 +22,7 @@ def build_parser() -> argparse.ArgumentParser:
     vccjax_cli.add_commands(sub)
     search_cli.add_commands(sub)
     argpred_cli.add_commands(sub)
+    robot_cli.add_commands(sub)
     bench.add_commands(sub)
     return p
 

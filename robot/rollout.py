@@ -1,0 +1,110 @@
+"""A concept carried out on the arm, for a batch of randomized scenarios.
+
+Per scenario: dress the scene and capture the camera image (C MuJoCo renderer), parse
+it, run the program on the parsed scene (reference interpreter), turn its hand
+instructions into keyframes; then every scenario's rollout runs at once under
+`jax.vmap` on MJX; finally each is judged against the VCC's output.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import jax
+import jax.numpy as jnp
+import mujoco
+import numpy as np
+
+from robot.camera import Camera
+from robot.control import TICK, Arm, Keyframes
+from robot.judge import Verdict, judge
+from robot.mjcf import scene_xml
+from robot.motion import keyframes
+from robot.plan import PickPlace, PlanError, plan
+from robot.scenario import Scenario, draw
+from vccjax.errors import SceneError
+from vccjax.program import Program
+from vccjax.scene import Scene
+
+RECORD_EVERY = 5  # ticks between recorded states (10 Hz)
+
+
+@dataclasses.dataclass
+class Prepared:
+    scenario: Scenario
+    parsed: Scene | None
+    moves: list[PickPlace]
+    expected: Scene | None  # the VCC's output on the parsed scene
+    keyframes: Keyframes | None
+    ticks: int
+    error: str | None  # "parse error: ..." or "plan error: ..."
+    windows: list[tuple[int, int]] = dataclasses.field(default_factory=list)  # per move: ticks held aloft
+
+
+class Bench:
+    """The compiled model, its renderer and its jitted rollout, made once."""
+
+    def __init__(self):
+        self.model = mujoco.MjModel.from_xml_string(scene_xml())
+        self.data = mujoco.MjData(self.model)
+        self.arm = Arm(self.model)
+        self._camera: Camera | None = None
+
+    @property
+    def camera(self) -> Camera:
+        if self._camera is None:
+            self._camera = Camera(self.model)
+        return self._camera
+
+    def prepare(self, program: Program | list[Program], scenario: Scenario) -> Prepared:
+        m, d = self.model, self.data
+        d.qpos[:] = scenario.qpos(m)
+        scenario.dress(m, d)
+        mujoco.mj_forward(m, d)
+        start = d.site("tcp").xpos.copy()
+        x_axis = d.site("tcp").xmat.reshape(3, 3)[:, 0]
+        start_yaw = float(np.arctan2(x_axis[1], x_axis[0]))
+        try:
+            parsed, _ = self.camera.scene(d)
+        except SceneError as e:
+            return Prepared(scenario, None, [], None, None, 0, f"parse error: {e}")
+        try:
+            moves, expected = plan(program, parsed)
+            kf, ticks, windows = keyframes(moves, start, start_yaw)
+        except (PlanError, ValueError) as e:
+            return Prepared(scenario, parsed, [], None, None, 0, f"plan error: {e}")
+        return Prepared(scenario, parsed, moves, expected, kf, ticks, None, windows)
+
+    def run(self, program: Program | list[Program], scenarios: list[Scenario], keep: bool = False
+            ) -> tuple[list[Verdict], dict, list[np.ndarray | None]]:
+        """Prepare, roll out (one batch) and judge; returns verdicts, timings, and (with
+        `keep`) each scenario's recorded qpos."""
+        t0 = time.perf_counter()
+        prepared = [self.prepare(program, s) for s in scenarios]
+        t_prep = time.perf_counter() - t0
+        live = [p for p in prepared if p.error is None]
+        records: dict[int, np.ndarray] = {}
+        t_compile = t_run = 0.0
+        ticks = 0
+        if live:
+            ticks = int(np.ceil((max(p.ticks for p in live) + 25) / RECORD_EVERY)) * RECORD_EVERY
+            q0 = jnp.asarray(np.stack([p.scenario.qpos(self.model) for p in live]))
+            kf = jax.tree.map(lambda *x: jnp.asarray(np.stack(x)), *[p.keyframes for p in live])
+            t1 = time.perf_counter()
+            lowered = self.arm.rollout.lower(q0, kf, ticks, RECORD_EVERY)
+            compiled = lowered.compile()
+            t_compile = time.perf_counter() - t1
+            t2 = time.perf_counter()
+            qs = np.asarray(jax.block_until_ready(compiled(q0, kf)))
+            t_run = time.perf_counter() - t2
+            for k, p in enumerate(live):
+                records[id(p)] = qs[k]
+        verdicts = [judge(self.model, p, records.get(id(p))) for p in prepared]
+        kept = [records.get(id(p)) for p in prepared] if keep else []
+        return verdicts, {"prepare_s": t_prep, "compile_s": t_compile, "rollout_s": t_run, "ticks": ticks,
+                          "simulated_s": ticks * TICK, "scenarios": len(scenarios)}, kept
+
+
+def scenarios_for(program: Program | list[Program], n: int, seed: int = 0) -> list[Scenario]:
+    return [draw(program, seed * 100_003 + k) for k in range(n)]
