@@ -39,9 +39,10 @@ def mesh_vertices(body: Body) -> np.ndarray | None:
     """(V, 3) vertices of a body's convex hull, centred on its bounding box (None for a
     primitive). Under 32 vertices: MJX's hull collisions are measured fast up to there."""
     r, h = body.size / 2, body.height / 2
-    if body.kind == "prism":  # apex towards +x (image up), base along y at -x
-        tri = np.array([[r, 0.0], [-r, -r], [-r, r]])
-        return np.concatenate([np.c_[tri, np.full(3, -h)], np.c_[tri, np.full(3, h)]])
+    if body.kind == "prism":  # a triangle, apex towards +x (image up), its three corners cut flat
+        a = 0.003  # half the apex's flat; the base corners end in flats as long as 2a
+        tri = np.array([[r, a], [2 * a - r, r], [-r, r], [-r, -r], [2 * a - r, -r], [r, -a]])
+        return np.concatenate([np.c_[tri, np.full(6, -h)], np.c_[tri, np.full(6, h)]])
     if body.kind == "lemon":  # a round body with a small flat bottom, so it stands
         ry = r * 0.86
         # the widest band is upright (rings in line), so a pad squeezing it pushes straight in, not down
@@ -59,7 +60,7 @@ def _object_xml(k: int, body: Body) -> str:
     if body.kind == "box":
         geom = f'<geom name="obj{k}" type="box" size="{_fmt([body.size / 2, body.size / 2, body.height / 2])}" {common}/>'
     elif body.kind == "ball":  # rolling friction (condim 6), so that a ball set down stays
-        common = common.replace('condim="3" friction="0.9 0.005 0.0001"', 'condim="6" friction="0.9 0.005 0.002"')
+        common = common.replace('condim="3" friction="0.9 0.005 0.0001"', 'condim="6" friction="0.9 0.02 0.02"')
         geom = f'<geom name="obj{k}" type="sphere" size="{body.size / 2:.6g}" {common}/>'
     else:
         geom = f'<geom name="obj{k}" type="mesh" mesh="mesh_{body.name}" {common}/>'
@@ -77,7 +78,7 @@ def _arm_xml() -> str:
     p, f = PAD_HALF, FINGER_OPEN
     link = 'contype="0" conaffinity="0" rgba="0.7 0.72 0.75 1" material="metal"'
     pad = (f'contype="{_PAD}" conaffinity="{_OBJECT}" condim="3" friction="1.5 0.005 0.0001" '
-           f'solref="0.01 1" solimp="0.95 0.99 0.001" rgba="0.15 0.15 0.15 1" material="matte"')
+           f'solref="0.01 1" solimp="0.99 0.999 0.001" rgba="0.15 0.15 0.15 1" material="matte"')
     pz = TCP_DEPTH + 0.015 - p[2]  # pads end 1.5 cm below the tool centre point
     return f"""
     <body name="base" pos="0 0 0">
@@ -181,9 +182,7 @@ def scene_xml() -> str:
     {_arm_xml()}
     {objects}
   </worldbody>
-  <contact>
-    {"".join(f'<exclude body1="slot{_slot(a)}" body2="slot{_slot(b)}"/>' for a, b in APART)}
-  </contact>
+  {_excludes()}
   <equality>
     <joint joint1="finger_a" joint2="finger_b" polycoef="0 1 0 0 0" solref="0.005 1"/>
   </equality>
@@ -199,6 +198,11 @@ def scene_xml() -> str:
 
 def _slot(name: str) -> int:
     return [b.name for b in BODIES].index(name)
+
+
+def _excludes() -> str:
+    pairs = "".join(f'<exclude body1="slot{_slot(a)}" body2="slot{_slot(b)}"/>' for a, b in APART)
+    return f"<contact>{pairs}</contact>" if pairs else ""
 
 
 def table_materials() -> dict[str, str]:

@@ -119,8 +119,8 @@ ROOM = 0.012 / WORKSPACE_SIDE  # gap between an open pad and the gripped object
 
 def grip_yaw(mv: PickPlace) -> float:
     """Finger axis (radians from world +x): across two parallel faces of the object, and
-    of those the one whose open pads keep farthest from every other object at the grab
-    and at the release (ties: square to the last leg of the path)."""
+    of those the one whose pads keep farthest from every other object at the grab, along
+    the carry and at the release (ties: square to the last leg of the path)."""
     if mv.shape == "circle":
         choices = list(np.linspace(0, np.pi, 8, endpoint=False))
     elif mv.shape == "square":
@@ -128,7 +128,7 @@ def grip_yaw(mv: PickPlace) -> float:
     elif mv.shape == "diamond":
         choices = [np.pi / 4, 3 * np.pi / 4]
     elif mv.shape == "triangle":
-        choices = [0.0]  # the base face against the apex edge
+        choices = [0.0, np.pi / 2]  # base face against the apex's flat, or across the base corners' flats
     else:
         raise PlanError(f"no grasp for a {mv.shape}")
     (u0, v0), (u1, v1) = mv.path[-2], mv.path[-1]
@@ -138,7 +138,11 @@ def grip_yaw(mv: PickPlace) -> float:
     def clearance(yaw: float) -> float:
         du, dv = -np.sin(yaw), -np.cos(yaw)  # the finger axis in workspace terms
         worst = np.inf
-        for centre, around in ((mv.path[0], mv.around_pick), (mv.path[-1], mv.around_place)):
+        # the grab, points along the carry (the others stand still meanwhile), and the release
+        legs = [np.array(mv.path[i]) + f * (np.array(mv.path[i + 1]) - np.array(mv.path[i]))
+                for i in range(len(mv.path) - 1) for f in np.linspace(0, 1, 6)[1:-1]]
+        for centre, around in ((mv.path[0], mv.around_pick), *((c, mv.around_pick) for c in legs),
+                               (mv.path[-1], mv.around_place)):
             for sign in (1, -1):
                 pu, pv = centre[0] + sign * half * du, centre[1] + sign * half * dv
                 for x, y, w, _ in around:

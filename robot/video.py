@@ -23,10 +23,11 @@ def write_video(model: mujoco.MjModel, scenario, qs: np.ndarray, path: str | Pat
     data = mujoco.MjData(model)
     scenario.dress(model, data)
     fps = 1.0 / (every * TICK)
-    out = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*fourcc), fps, (size * 16 // 9, size))
+    width = size * 16 // 9 // 2 * 2  # codecs want even sizes
+    out = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*fourcc), fps, (width, size))
     if not out.isOpened():
         raise OSError(f"{path}: OpenCV cannot write this video here")
-    with mujoco.Renderer(model, size, size * 16 // 9) as r:
+    with mujoco.Renderer(model, size, width) as r:
         for q in qs:
             data.qpos[:] = q
             mujoco.mj_forward(model, data)

@@ -67,11 +67,12 @@ BODIES: tuple[Body, ...] = (
     Body("ball_s", "ball", 0.040, 0.040),
     Body("ball_l", "ball", 0.050, 0.050),
     Body("lemon", "lemon", 0.054, 0.042),
-    Body("prism", "prism", 0.048, 0.035),
 )
-# MJX computes every allowed contact pair every step (a convex-convex pair is its own
-# compiled group): the two hull bodies never stand on the table together, so they need no contact
-APART: tuple[tuple[str, str], ...] = (("lemon", "prism"),)
+# Bodies that never stand on the table together need no contact (MJX computes every allowed
+# pair every step). A triangular prism (corners cut flat) was tried as a seventh body and
+# dropped: it tipped out of the grip in 7 of 32 rollouts of a triangle-stacking concept, so
+# concepts that need triangles (or stars) are not carried out on the arm.
+APART: tuple[tuple[str, str], ...] = ()
 
 COLORS_RGB: dict[str, tuple[float, float, float]] = {
     "red": (0.85, 0.08, 0.08), "green": (0.10, 0.62, 0.18),

@@ -1,0 +1,174 @@
+"""The robot: camera to scene, VCC plan to arm motion, physics on C MuJoCo and MJX, judging."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robot  # noqa: F401  (sets MUJOCO_GL before mujoco is imported)
+from robot.judge import judge
+from robot.motion import keyframes
+from robot.plan import PlanError, grip_yaw, plan
+from robot.reference import rollout as c_rollout
+from robot.rollout import RECORD_EVERY, Bench, scenarios_for
+from robot.scenario import draw
+from robot.world import to_table, to_workspace
+from vccjax.concepts import reference_program
+from vccjax.program import parse
+from vccjax.reference import RefMachine
+from vccjax.scene import Scene, SceneObject, scenes_match
+
+STACK = "stack_in_place_horizontal_left"
+POINTED = "move_bottom_to_pointed"
+
+
+@pytest.fixture(scope="module")
+def bench():
+    return Bench()
+
+
+def test_workspace_and_table_coordinates_round_trip():
+    uv = np.random.default_rng(0).uniform(0, 1, (20, 2))
+    xy = to_table(uv[:, 0], uv[:, 1])
+    np.testing.assert_allclose(to_workspace(xy[:, 0], xy[:, 1]), uv, atol=1e-12)
+    # image up is away from the arm (+x), image right is the arm's right (-y)
+    assert to_table(0.5, 0.0)[0] > to_table(0.5, 1.0)[0] and to_table(1.0, 0.5)[1] < to_table(0.0, 0.5)[1]
+
+
+def test_a_rendered_camera_frame_parses_to_the_scenario(bench):
+    for seed, concept in enumerate([POINTED, STACK, POINTED]):
+        sc = draw(reference_program(concept), seed)
+        d = bench.data
+        d.qpos[:] = sc.qpos(bench.model)
+        sc.dress(bench.model, d)
+        import mujoco
+
+        mujoco.mj_forward(bench.model, d)
+        parsed, view = bench.camera.scene(d)
+        assert view.shape == (384, 384, 3)
+        assert scenes_match(parsed, sc.scene, 0.02), (parsed, sc.scene)
+        assert (parsed.pointer is None) == (sc.scene.pointer is None)
+        if parsed.pointer is not None:
+            assert np.hypot(*np.subtract(parsed.pointer, sc.scene.pointer)) < 0.02
+
+
+def test_plan_carries_each_moved_object_to_the_vcc_output():
+    program = reference_program(STACK)
+    scene = draw(program, 3).scene
+    moves, out = plan(program, scene)
+    expected = RefMachine(scene).run(program).output_scene()
+    assert out == expected and moves
+    for mv in moves:
+        assert mv.path[0] == pytest.approx((scene.objects[mv.slot].x, scene.objects[mv.slot].y), abs=1e-3)
+        assert mv.path[-1] == pytest.approx((out.objects[mv.slot].x, out.objects[mv.slot].y), abs=1e-3)
+    # a composition runs the second program on the first one's output
+    second = reference_program("move_green_to_right_bottom_corner")
+    both, out2 = plan([program, second], scene)
+    assert both[: len(moves)] == moves and out2 == RefMachine(out).run(second).output_scene()
+
+
+def test_plan_refuses_what_no_arm_can_do():
+    scene = Scene((SceneObject("square", "red", 0.3, 0.3, 0.1), SceneObject("circle", "blue", 0.7, 0.7, 0.1)))
+    with pytest.raises(PlanError, match="fill_color recolours an object"):
+        plan(parse("scene_parse; top_down_attend; fill_color(green)"), scene)
+    with pytest.raises(PlanError, match="failed at instruction 1"):
+        plan(parse("scene_parse; grab_object"), scene)
+
+
+def test_grip_yaw_keeps_the_pads_off_a_neighbour():
+    # a square set down just left of another: the fingers must close along the column, not the row
+    from robot.plan import PickPlace
+
+    mv = PickPlace(0, "square", 0.1, ((0.2, 0.5), (0.5, 0.5)), (), ((0.61, 0.5, 0.1, "square"),))
+    yaw = grip_yaw(mv)
+    du, dv = -np.sin(yaw), -np.cos(yaw)  # the finger axis in workspace terms
+    assert abs(du) < 1e-6 and abs(abs(dv) - 1) < 1e-6
+
+
+def test_keyframes_are_in_order_and_padded(bench):
+    program = reference_program(STACK)
+    sc = draw(program, 1)
+    moves, _ = plan(program, sc.scene)
+    kf, ticks, windows = keyframes(moves, np.array([0.13, -0.49, 0.37]), np.pi)
+    assert (np.diff(kf.tick) > 0).all() and kf.tick.shape == kf.yaw.shape == kf.grip.shape
+    assert len(windows) == len(moves) and all(0 < a < b <= ticks for a, b in windows)
+    assert kf.pos[:, 2].min() > 0.0  # never into the table
+
+
+def test_a_c_mujoco_rollout_succeeds_and_a_gripper_that_never_closes_slips(bench):
+    program = reference_program(POINTED)
+    sc = scenarios_for(program, 1, seed=0)[0]
+    prepared = bench.prepare(program, sc)
+    assert prepared.error is None
+    ticks = (prepared.ticks // RECORD_EVERY + 6) * RECORD_EVERY
+    qs = c_rollout(bench.model, sc.qpos(bench.model), prepared.keyframes, ticks, RECORD_EVERY)
+    verdict = judge(bench.model, prepared, qs)
+    assert verdict.success, verdict
+    assert np.isfinite(qs).all()
+    import dataclasses
+
+    never = dataclasses.replace(prepared.keyframes, grip=np.full_like(prepared.keyframes.grip, 0.04))
+    qs = c_rollout(bench.model, sc.qpos(bench.model), never, ticks, RECORD_EVERY)
+    bad = judge(bench.model, dataclasses.replace(prepared, keyframes=never), qs)
+    assert not bad.success and bad.cause == "grasp slipped"
+
+
+def test_a_scene_the_camera_cannot_parse_is_a_parse_error(bench, monkeypatch):
+    from vccjax.errors import SceneError
+
+    program = reference_program(POINTED)
+    sc = scenarios_for(program, 1, seed=2)[0]
+
+    def blind(data):
+        raise SceneError("no objects found in the image")
+
+    monkeypatch.setattr(bench.camera, "scene", blind)
+    p = bench.prepare(program, sc)
+    v = judge(bench.model, p, None)
+    assert not v.success and v.cause == "parse error" and "no objects" in v.detail
+
+
+def test_mjx_rollout_agrees_with_the_c_reference(bench):
+    """gymnax-style: the batched MJX rollout against the NumPy controller on C MuJoCo."""
+    import jax
+    import jax.numpy as jnp
+
+    program = reference_program(POINTED)
+    sc = scenarios_for(program, 1, seed=0)[0]
+    p = bench.prepare(program, sc)
+    ticks = 60  # the arm's first move, towards the object
+    q0 = sc.qpos(bench.model)
+    ref = c_rollout(bench.model, q0, p.keyframes, ticks, 10)
+    kf = jax.tree.map(lambda x: jnp.asarray(np.asarray(x)[None]), p.keyframes)
+    got = np.asarray(bench.arm.rollout(jnp.asarray(q0[None]), kf, ticks, 10))[0]
+    arm = bench.arm.arm_qpos
+    np.testing.assert_allclose(got[:, arm], ref[:, arm], atol=2e-3)  # radians
+    assert np.isfinite(got).all()
+
+
+def test_robot_cli_errors_are_one_line(capsys):
+    from vcc.cli import main
+
+    for argv, message in [
+        (["robot", "run", "--concept", "no_such_concept"], "unknown concept 'no_such_concept'"),
+        (["robot", "run", "--concept", "x", "--program", "scene_parse; jump"], "unknown instruction"),
+    ]:
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.startswith("vcc: error: ") and message in err and err.count("\n") == 1, err
+
+
+def test_video_of_a_rollout_is_written(bench, tmp_path):
+    from robot.video import write_video
+
+    program = reference_program(POINTED)
+    sc = scenarios_for(program, 1, seed=0)[0]
+    p = bench.prepare(program, sc)
+    qs = c_rollout(bench.model, sc.qpos(bench.model), p.keyframes, 40, 10)
+    path = tmp_path / "one.mp4"
+    assert write_video(bench.model, sc, qs, path, 10, size=120) == 4
+    import cv2
+
+    cap = cv2.VideoCapture(str(path))
+    ok, frame = cap.read()
+    assert ok and frame.shape == (120, 212, 3)
