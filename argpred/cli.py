@@ -41,7 +41,7 @@ def cmd_train(a: argparse.Namespace) -> int:
     else:
         have = argdata.built(folders[0]) if folders else None  # an existing folder keeps its count and draw
         programs = a.programs or (have or {}).get("programs", 1000)
-        joined = a.joined if a.joined is not None else (have or {}).get("joined", 0.0)
+        joined = a.joined if a.joined is not None else (have or {}).get("joined", 0.3)
         tag = f"-joined{joined:g}" if joined else ""
         folder = Path(folders[0]) if folders else DEFAULT_DATA / f"seed{a.seed}-{programs}{tag}"
         argdata.build(folder, programs, seed=have["seed"] if have else a.seed,
@@ -88,8 +88,9 @@ def add_commands(sub) -> None:
     d.add_argument("--out", required=True, help="data folder (an existing one is resumed)")
     d.add_argument("--programs", type=int, default=1000, help="programs to draw (default 1000)")
     d.add_argument("--seed", type=int, default=0)
-    d.add_argument("--joined", type=float, default=0.0,
-                   help="share of programs drawn as two parts joined by reset_attn (default 0)")
+    d.add_argument("--joined", type=float, default=0.3,
+                   help="share of programs drawn as two parts joined by reset_attn (default 0.3, as the "
+                        "shipped weights)")
     d.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")
     d.add_argument("--quiet", action="store_true")
     d.set_defaults(fn=cmd_data)
@@ -108,11 +109,11 @@ def add_commands(sub) -> None:
     t.add_argument("--batch", type=int, default=64)
     t.add_argument("--lr", type=float, default=3e-3, help="Adam learning rate")
     t.add_argument("--l1", type=float, default=1e-4, help="L1 weight on the kernels")
-    t.add_argument("--positive-weight", type=float, default=4.0,
+    t.add_argument("--positive-weight", type=float, default=16.0,
                    help="loss weight of a used argument (>1 favours recall over extra arguments)")
     t.add_argument("--hidden", type=int, default=32, help="hidden channels (0: the paper's single convolution)")
     t.add_argument("--joined", type=float, default=None,
-                   help="share of two-part programs in newly drawn data (default: the folder's, else 0)")
+                   help="share of two-part programs in newly drawn data (default: the folder's, else 0.3)")
     t.add_argument("--kernel", type=int, default=3)
     t.add_argument("--depth", type=int, default=1, help="hidden convolutions (with --hidden > 0)")
     t.add_argument("--seed", type=int, default=0)

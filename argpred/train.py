@@ -35,7 +35,7 @@ class TrainSettings:
     batch: int = 64
     learning_rate: float = 3e-3
     l1: float = 1e-4  # on the sum of |kernel weights|
-    positive_weight: float = 4.0  # > 1 trades extra arguments for recall (a missed one loses the concept)
+    positive_weight: float = 16.0  # > 1 trades extra arguments for recall (a missed one loses the concept)
     validation: float = 0.1  # share of programs held out
     seed: int = 0
 

@@ -27,15 +27,7 @@ def _program(a: argparse.Namespace):
 
 
 def cmd_run(a: argparse.Namespace) -> int:
-    if XLA_FLAG not in os.environ.get("XLA_FLAGS", ""):
-        os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " " + XLA_FLAG).strip()
-    if hasattr(os, "sched_setaffinity") and not a.all_cores:
-        # batched MJX on both cores of this CPU hung inside XLA's batched Cholesky (batch 32, twice
-        # in two tries); pinned to one core it runs, and that is measured as fast (shared/notes)
-        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
-    from search.cli import enable_compile_cache
-
-    enable_compile_cache()
+    _setup_mjx(a)
     from robot.judge import CAUSES
     from robot.rollout import RECORD_EVERY, Bench, scenarios_for
 
@@ -62,9 +54,35 @@ def cmd_run(a: argparse.Namespace) -> int:
     if a.json:
         Path(a.json).write_text(json.dumps({
             "concept": a.concept,
-            "program": [p.text() for p in (program if isinstance(program, list) else [program])], "scenarios": a.scenarios, "seed": a.seed,
+            "program": [p.text() for p in (program if isinstance(program, list) else [program])],
+            "scenarios": a.scenarios, "seed": a.seed,
             "success": ok, "timing": info, "verdicts": [v.__dict__ for v in verdicts]}, indent=1))
     print(f"success: {ok} of {len(verdicts)} ({ok / max(1, len(verdicts)):.1%})")
+    return 0
+
+
+def _setup_mjx(a: argparse.Namespace) -> None:
+    """Before JAX starts: the XLA flag, one core, the compile cache."""
+    if XLA_FLAG not in os.environ.get("XLA_FLAGS", ""):
+        os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " " + XLA_FLAG).strip()
+    if hasattr(os, "sched_setaffinity") and not a.all_cores:
+        # batched MJX on both cores of this CPU hung inside XLA's batched Cholesky (batch 32, twice
+        # in two tries); pinned to one core it runs, and that is measured as fast (shared/notes)
+        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+    from search.cli import enable_compile_cache
+
+    enable_compile_cache()
+
+
+def cmd_suite(a: argparse.Namespace) -> int:
+    _setup_mjx(a)
+    from robot.suite import run_suite
+
+    s = run_suite(a.out, a.scenarios, a.seed)
+    for name, rate in s["per_concept"].items():
+        print(f"{rate:7.1%}  {name}")
+    print("failures: " + (", ".join(f"{c} {n}" for c, n in s["failures"].items()) or "none"))
+    print(f"success: {s['success']} of {s['rollouts']} ({s['success'] / max(1, s['rollouts']):.1%})")
     return 0
 
 
@@ -86,3 +104,10 @@ def add_commands(sub) -> None:
     r.add_argument("--all-cores", action="store_true",
                    help="let XLA use every core (on a 2-core CPU this hung at 32 scenarios)")
     r.set_defaults(fn=cmd_run)
+
+    u = s.add_parser("suite", help="the ten-concept benchmark, resumable (one JSON per concept)")
+    u.add_argument("--out", required=True, help="results folder (an existing one is resumed)")
+    u.add_argument("--scenarios", type=int, default=32)
+    u.add_argument("--seed", type=int, default=0)
+    u.add_argument("--all-cores", action="store_true", help="let XLA use every core")
+    u.set_defaults(fn=cmd_suite)

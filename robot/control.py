@@ -24,6 +24,8 @@ TICK = 0.02  # seconds
 MAX_STEP = 0.02  # metres of Cartesian error acted on per tick
 MAX_TURN = 0.15  # radians of orientation error acted on per tick
 DAMPING = 0.05  # of the least-squares step
+RECORD = 5  # ticks between recorded states (10 Hz)
+CHUNK = 250  # ticks per compiled piece of rollout (5 s)
 
 
 @struct.dataclass
@@ -59,7 +61,9 @@ class Arm:
         self.gripper_body = model.body("gripper").id
         self.grip_act = model.actuator("grip").id
         self.arm_act = np.array([model.actuator(j).id for j in ARM_JOINTS])
-        self.rollout = jax.jit(self._rollout, static_argnums=(2, 3))
+        self._compiled: dict = {}
+        self.start = jax.jit(self._start)
+        self.advance = jax.jit(self._advance)
 
     def ctrl(self, d: mjx.Data, pos: jax.Array, yaw: jax.Array, grip: jax.Array) -> jax.Array:
         """One tick of damped-least-squares differential IK: joint targets for the servos."""
@@ -80,26 +84,52 @@ class Arm:
         ctrl = d.ctrl.at[self.arm_act].set(q)
         return ctrl.at[self.grip_act].set(grip)
 
-    def _rollout(self, qpos0: jax.Array, kf: Keyframes, ticks: int, record_every: int = 1) -> jax.Array:
-        """Batched: qpos0 (B, nq) and keyframes (B, K); returns qpos (B, T, nq) every
-        `record_every` ticks. The model is closed over (passing it costs ~40 ms a call)."""
+    def _start(self, qpos0: jax.Array) -> mjx.Data:
+        """Batched initial states: qpos0 (B, nq), servos holding the arm where it is."""
 
-        def one(q0, kf1):
+        def one(q0):
             d = mjx.make_data(self.mx).replace(qpos=q0)
             d = d.replace(ctrl=d.ctrl.at[self.arm_act].set(q0[self.arm_qpos]))
-            d = mjx.forward(self.mx, d)
+            return mjx.forward(self.mx, d)
 
+        return jax.vmap(one)(qpos0)
+
+    def _advance(self, d: mjx.Data, kf: Keyframes, t0: jax.Array) -> tuple[mjx.Data, jax.Array]:
+        """CHUNK control ticks from tick t0 for a batch; qpos every RECORD ticks. Every
+        concept's rollout is a number of these chunks, so one compilation serves all (per
+        batch size). The model is closed over (passing it costs ~40 ms a call)."""
+
+        def one(d, kf1):
             def tick(d, t):
                 pos, yaw, grip = target_at(kf1, t)
                 d = d.replace(ctrl=self.ctrl(d, pos, yaw, grip))
                 d = jax.lax.fori_loop(0, SUBSTEPS, lambda _, x: mjx.step(self.mx, x), d)
+                return d, None
+
+            def record(d, t):
+                d, _ = jax.lax.scan(tick, d, t + jnp.arange(RECORD))
                 return d, d.qpos
 
-            def chunk(d, t0):
-                d, qs = jax.lax.scan(tick, d, t0 + jnp.arange(record_every))
-                return d, qs[-1]
+            return jax.lax.scan(record, d, t0 + jnp.arange(CHUNK // RECORD) * RECORD)
 
-            _, qs = jax.lax.scan(chunk, d, jnp.arange(ticks // record_every) * record_every)
-            return qs
+        return jax.vmap(one)(d, kf)
 
-        return jax.vmap(one)(qpos0, kf)
+    def compile(self, qpos0: jax.Array, kf: Keyframes):
+        """Both pieces compiled for this batch's shapes (kept per batch size), so that a
+        rollout's timing keeps compilation apart."""
+        key = (qpos0.shape, kf.tick.shape)
+        if key not in self._compiled:
+            d = jax.eval_shape(self.start, qpos0)
+            self._compiled[key] = (self.start.lower(qpos0).compile(),
+                                   self.advance.lower(d, kf, jnp.int32(0)).compile())
+        return self._compiled[key]
+
+    def rollout(self, qpos0: jax.Array, kf: Keyframes, ticks: int) -> np.ndarray:
+        """qpos (B, ceil(ticks / CHUNK) * CHUNK / RECORD, nq), recorded every RECORD ticks."""
+        start, advance = self.compile(qpos0, kf)
+        d = start(qpos0)
+        out = []
+        for t0 in range(0, ticks, CHUNK):
+            d, qs = advance(d, kf, jnp.int32(t0))
+            out.append(np.asarray(qs))
+        return np.concatenate(out, axis=1)
