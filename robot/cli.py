@@ -61,14 +61,18 @@ def cmd_run(a: argparse.Namespace) -> int:
     return 0
 
 
-def _setup_mjx(a: argparse.Namespace) -> None:
-    """Before JAX starts: the XLA flag, one core, the compile cache."""
+def prepare_process(argv: list[str]) -> None:
+    """Before JAX starts (importing vccjax starts it, so `vcc` calls this first for `vcc
+    robot`): the XLA flag that makes batched MJX fast on CPU, and one core (batched MJX
+    on both cores of this CPU hung inside XLA's batched Cholesky, batch 32, twice in two
+    tries; pinned to one core it runs, as fast: shared/notes/mjx-on-cpu.md)."""
     if XLA_FLAG not in os.environ.get("XLA_FLAGS", ""):
         os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " " + XLA_FLAG).strip()
-    if hasattr(os, "sched_setaffinity") and not a.all_cores:
-        # batched MJX on both cores of this CPU hung inside XLA's batched Cholesky (batch 32, twice
-        # in two tries); pinned to one core it runs, and that is measured as fast (shared/notes)
+    if hasattr(os, "sched_setaffinity") and "--all-cores" not in argv:
         os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+
+
+def _setup_mjx(a: argparse.Namespace) -> None:
     from search.cli import enable_compile_cache
 
     enable_compile_cache()

@@ -5,11 +5,16 @@ from __future__ import annotations
 import argparse
 import sys
 
-from argpred import cli as argpred_cli
-from robot import cli as robot_cli
-from search import cli as search_cli
-from vcc import bench
-from vccjax import cli as vccjax_cli
+if len(sys.argv) > 1 and sys.argv[1] == "robot":  # MJX's XLA settings must precede JAX's start,
+    from robot.cli import prepare_process  # which importing vccjax triggers
+
+    prepare_process(sys.argv[2:])
+
+from argpred import cli as argpred_cli  # noqa: E402
+from robot import cli as robot_cli  # noqa: E402
+from search import cli as search_cli  # noqa: E402
+from vcc import bench  # noqa: E402
+from vccjax import cli as vccjax_cli  # noqa: E402
 
 
 def build_parser() -> argparse.ArgumentParser:
