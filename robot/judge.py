@@ -17,7 +17,7 @@ import dataclasses
 import mujoco
 import numpy as np
 
-from robot.control import TICK
+from robot.control import RECORD as RECORD_EVERY, TICK
 from robot.world import BODIES, on_table, to_table
 
 TOLERANCE = 0.02
@@ -55,8 +55,6 @@ def judge(model: mujoco.MjModel, prepared, qs: np.ndarray | None) -> Verdict:
     if prepared.error is not None:
         cause = prepared.error.split(":")[0]
         return Verdict(False, cause, prepared.error, float("nan"), seed)
-    from robot.rollout import RECORD_EVERY  # noqa: PLC0415 (one module's constant, no cycle at import)
-
     sc, parsed, expected = prepared.scenario, prepared.parsed, prepared.expected
     truth = sc.scene.objects
     # each parsed object is the true object nearest it (parsing was checked to be close)
