@@ -12,24 +12,21 @@ XLA_FLAG = "--xla_cpu_use_fusion_emitters=false"  # batched MJX 14x faster on CP
 
 
 def _program(a: argparse.Namespace):
-    from vccjax.concepts import concept_names, reference_program
     from vccjax.program import parse
 
     if a.program:
         text = Path(a.program).read_text() if Path(a.program).is_file() else a.program
         return parse(text)
-    parts = a.concept.split("+")  # A+B: A's program, then B's on the scene A leaves
-    unknown = [c for c in parts if c not in concept_names()]
-    if unknown:
-        raise ValueError(f"unknown concept {', '.join(map(repr, unknown))} (see `vcc concepts`)")
-    programs = [reference_program(c) for c in parts]
-    return programs[0] if len(programs) == 1 else programs
+    from robot.suite import programs_of
+
+    return programs_of(a.concept)
 
 
 def cmd_run(a: argparse.Namespace) -> int:
     _setup_mjx(a)
     from robot.judge import CAUSES
-    from robot.rollout import RECORD_EVERY, Bench, scenarios_for
+    from robot.control import RECORD
+    from robot.rollout import Bench, scenarios_for
 
     program = _program(a)
     bench = Bench()
@@ -49,7 +46,7 @@ def cmd_run(a: argparse.Namespace) -> int:
         if k is None:
             print("no scenario ran: no video")
         else:
-            n = write_video(bench.model, scenarios[k], records[k], a.video, RECORD_EVERY)
+            n = write_video(bench.model, scenarios[k], records[k], a.video, RECORD)
             print(f"video: {a.video} ({n} frames, scenario {k})")
     if a.json:
         Path(a.json).write_text(json.dumps({

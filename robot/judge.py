@@ -17,7 +17,7 @@ import dataclasses
 import mujoco
 import numpy as np
 
-from robot.control import RECORD as RECORD_EVERY, TICK
+from robot.control import RECORD, TICK
 from robot.world import BODIES, on_table, to_table
 
 TOLERANCE = 0.02
@@ -69,7 +69,7 @@ def judge(model: mujoco.MjModel, prepared, qs: np.ndarray | None) -> Verdict:
     worst = float(err.max()) if len(err) else 0.0
     tcp = _tcp(model, qs)
     kf = prepared.keyframes
-    ticks = np.arange(1, len(qs) + 1) * RECORD_EVERY
+    ticks = np.arange(1, len(qs) + 1) * RECORD
     reached = [np.min(np.linalg.norm(tcp - kf.pos[i], axis=1)) for i in range(len(kf.tick)) if kf.tick[i] <= ticks[-1]]
     if max(reached) > 0.02:
         return Verdict(False, "IK unreachable", f"a target stayed {max(reached) * 100:.1f} cm away", worst, seed)
@@ -87,7 +87,7 @@ def judge(model: mujoco.MjModel, prepared, qs: np.ndarray | None) -> Verdict:
         if z[0] < rest + 0.008:
             return Verdict(False, "grasp slipped", f"{BODIES[k].name} was not lifted", worst, seed)
         if (z < rest + 0.004).any():
-            t = (aloft + np.argmax(z < rest + 0.004) * RECORD_EVERY) * TICK
+            t = (aloft + np.argmax(z < rest + 0.004) * RECORD) * TICK
             return Verdict(False, "object dropped", f"{BODIES[k].name} fell at {t:.1f} s", worst, seed)
         lag = np.linalg.norm(xyz[window, k, :2] - tcp[window, :2], axis=1).max()
         if lag > 0.02:

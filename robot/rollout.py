@@ -27,7 +27,6 @@ from vccjax.errors import SceneError
 from vccjax.program import Program
 from vccjax.scene import Scene
 
-RECORD_EVERY = RECORD
 
 
 @dataclasses.dataclass
@@ -102,7 +101,7 @@ class Bench:
             t2 = time.perf_counter()
             qs = self.arm.rollout(q0, kf, ticks)
             t_run = time.perf_counter() - t2
-            ticks = qs.shape[1] * RECORD_EVERY
+            ticks = qs.shape[1] * RECORD
             for k, p in enumerate(live):
                 records[id(p)] = qs[k]
         verdicts = [judge(self.model, p, records.get(id(p))) for p in prepared]

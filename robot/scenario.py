@@ -150,7 +150,9 @@ def arm_concepts() -> list[str]:
     from vccjax.concepts import concept_names, reference_program
     from vccjax.instructions import NAMES
 
-    banned = {"fill_color", "remove_from_imagine_buffer", "imagine_object", "reset_imagination"}
+    from robot.plan import NOT_ON_A_ROBOT
+
+    banned = {*NOT_ON_A_ROBOT, "imagine_object", "reset_imagination"}  # imagined objects block carries
     out = []
     for name in concept_names():
         used = {NAMES[op] for op in reference_program(name).ops}

@@ -25,9 +25,14 @@ SUITE: tuple[str, ...] = (
 
 
 def programs_of(name: str):
-    from vccjax.concepts import reference_program
+    """A concept's reference program; for A+B, A's then B's (run on the scene A leaves)."""
+    from vccjax.concepts import concept_names, reference_program
 
-    programs = [reference_program(c) for c in name.split("+")]
+    parts = name.split("+")
+    unknown = [c for c in parts if c not in concept_names()]
+    if unknown:
+        raise ValueError(f"unknown concept {', '.join(map(repr, unknown))} (see `vcc concepts`)")
+    programs = [reference_program(c) for c in parts]
     return programs[0] if len(programs) == 1 else programs
 
 

@@ -11,7 +11,7 @@ from robot.control import CHUNK, RECORD
 from robot.motion import keyframes
 from robot.plan import PlanError, grip_yaw, plan
 from robot.reference import rollout as c_rollout
-from robot.rollout import RECORD_EVERY, Bench, scenarios_for
+from robot.rollout import Bench, scenarios_for
 from robot.scenario import draw
 from robot.world import to_table, to_workspace
 from vccjax.concepts import reference_program
@@ -101,15 +101,15 @@ def test_a_c_mujoco_rollout_succeeds_and_a_gripper_that_never_closes_slips(bench
     sc = scenarios_for(program, 1, seed=0)[0]
     prepared = bench.prepare(program, sc)
     assert prepared.error is None
-    ticks = (prepared.ticks // RECORD_EVERY + 6) * RECORD_EVERY
-    qs = c_rollout(bench.model, sc.qpos(bench.model), prepared.keyframes, ticks, RECORD_EVERY)
+    ticks = (prepared.ticks // RECORD + 6) * RECORD
+    qs = c_rollout(bench.model, sc.qpos(bench.model), prepared.keyframes, ticks, RECORD)
     verdict = judge(bench.model, prepared, qs)
     assert verdict.success, verdict
     assert np.isfinite(qs).all()
     import dataclasses
 
     never = dataclasses.replace(prepared.keyframes, grip=np.full_like(prepared.keyframes.grip, 0.04))
-    qs = c_rollout(bench.model, sc.qpos(bench.model), never, ticks, RECORD_EVERY)
+    qs = c_rollout(bench.model, sc.qpos(bench.model), never, ticks, RECORD)
     bad = judge(bench.model, dataclasses.replace(prepared, keyframes=never), qs)
     assert not bad.success and bad.cause == "grasp slipped"
 
