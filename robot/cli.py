@@ -87,6 +87,18 @@ def cmd_suite(a: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_stress(a: argparse.Namespace) -> int:
+    _setup_mjx(a)
+    from robot.stress import run_stress
+
+    s = run_stress(a.out, a.rollouts, a.seed)
+    print(f"{s['rollouts']} rollouts of {s['concepts']} concepts: {s['rolled_out']} rolled out, "
+          f"{s['success']} carried out, wall {s['wall_s']:.0f} s")
+    print("failures: " + (", ".join(f"{c} {n}" for c, n in s["failures"].items()) or "none"))
+    print(f"non-finite: {s['non_finite']}")
+    return 0 if s["non_finite"] == 0 else 1
+
+
 def add_commands(sub) -> None:
     p = sub.add_parser("robot", help="carry concepts out on a simulated arm (MuJoCo MJX) from a camera image")
     s = p.add_subparsers(dest="action", required=True, metavar="ACTION")
@@ -112,3 +124,10 @@ def add_commands(sub) -> None:
     u.add_argument("--seed", type=int, default=0)
     u.add_argument("--all-cores", action="store_true", help="let XLA use every core")
     u.set_defaults(fn=cmd_suite)
+
+    t = s.add_parser("stress", help="many rollouts of random concepts and scenarios: no NaN, no crash (resumable)")
+    t.add_argument("--out", required=True, help="results folder (an existing one is resumed)")
+    t.add_argument("--rollouts", type=int, default=1000, help="rollouts, in whole batches of 32 (default 1000)")
+    t.add_argument("--seed", type=int, default=7)
+    t.add_argument("--all-cores", action="store_true", help="let XLA use every core")
+    t.set_defaults(fn=cmd_stress)

@@ -1,0 +1,79 @@
+"""The arm's robustness run: many rollouts of random arm-compatible concepts on random
+scenarios, 32 at a time on MJX, each checked for non-finite state and judged. One JSON
+per batch, written when the batch finishes, so an interrupted run resumes where it
+stopped; each batch is drawn from its own seed, so a resumed run is the same run."""
+
+from __future__ import annotations
+
+import json
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+BATCH = 32
+
+
+def draw_batch(seed: int, batch: int, size: int = BATCH) -> list:
+    """`size` (program, scenario) pairs: concepts drawn uniformly from the arm's concepts,
+    a concept that no scenario of the arm's bodies lets run is drawn again."""
+    from robot.scenario import arm_concepts, draw
+    from vccjax.concepts import reference_program
+    from vccjax.errors import SceneError
+
+    rng = np.random.default_rng([seed, batch])
+    names = arm_concepts()
+    items = []
+    while len(items) < size:
+        name = names[int(rng.integers(len(names)))]
+        program = reference_program(name)
+        try:
+            items.append((name, program, draw(program, int(rng.integers(1 << 30)), max_tries=200)))
+        except SceneError:
+            continue
+    return items
+
+
+def run_stress(out: str | Path, rollouts: int = 1000, seed: int = 7, log=print) -> dict:
+    """Run (or resume) `rollouts` (rounded up to whole batches) into `out`; returns the
+    summary, also written there as summary.json."""
+    from tqdm import tqdm
+
+    from robot.rollout import Bench
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    batches = -(-rollouts // BATCH)
+    bench = None
+    for b in tqdm(range(batches), desc="robot stress", unit="batch"):
+        path = out / f"batch-{b:03d}.json"
+        if path.exists() and json.loads(path.read_text()).get("seed") == seed:
+            continue
+        bench = bench or Bench()
+        items = draw_batch(seed, b)
+        start = time.perf_counter()
+        verdicts, info, kept = bench.run_pairs([(p, s) for _, p, s in items], keep=True)
+        info["wall_s"] = time.perf_counter() - start
+        finite = [q is None or bool(np.isfinite(q).all()) for q in kept]
+        record = {"batch": b, "seed": seed, "timing": info,
+                  "concepts": [n for n, _, _ in items], "scenario_seeds": [s.seed for _, _, s in items],
+                  "rolled_out": sum(q is not None for q in kept), "non_finite": finite.count(False),
+                  "success": sum(v.success for v in verdicts),
+                  "failures": dict(Counter(v.cause for v in verdicts if not v.success)),
+                  "verdicts": [v.__dict__ for v in verdicts]}
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(record, indent=1))
+        tmp.replace(path)
+        log(f"batch {b}: {record['success']} of {len(items)} carried out, "
+            f"{record['non_finite']} non-finite, wall {info['wall_s']:.0f} s")
+    rows = [json.loads((out / f"batch-{b:03d}.json").read_text()) for b in range(batches)]
+    summary = {"seed": seed, "batches": batches, "rollouts": batches * BATCH,
+               "rolled_out": sum(r["rolled_out"] for r in rows),
+               "non_finite": sum(r["non_finite"] for r in rows),
+               "success": sum(r["success"] for r in rows),
+               "failures": dict(sum((Counter(r["failures"]) for r in rows), Counter())),
+               "concepts": len({c for r in rows for c in r["concepts"]}),
+               "wall_s": sum(r["timing"]["wall_s"] for r in rows)}
+    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    return summary
