@@ -49,13 +49,26 @@ def _read_program(text: str | None):
     return parse(text, body_max=DEFAULT_CONFIG.body_max)
 
 
-def cmd_run(a: argparse.Namespace) -> int:
+def read_image(path: str):
+    """An image file as RGB uint8, or a one-line error."""
+    import cv2
+
+    if not Path(path).is_file():
+        raise VCCError(f"{path}: no such image file")
+    img = cv2.imread(path, cv2.IMREAD_COLOR)
+    if img is None:
+        raise VCCError(f"{path}: not an image OpenCV can read")
+    return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
+
+
+def program_and_scene(a: argparse.Namespace):
+    """(program, scene, note, expected output or None) from the shared flags of `vcc run`
+    and `vcc trace`: PROGRAM or --concept; --scene, --image, --example K of the concept,
+    or a seeded random scene."""
     from vccjax.concepts import reference_program
-    from vccjax.emulator import run
     from vccjax.generate import random_scene
     from vccjax.reference import run_reference
     from vccjax.scene import Scene, scenes_match
-    from vccjax.state import load_scene, output_scene
 
     cfg = DEFAULT_CONFIG
     program = _read_program(a.program)
@@ -63,16 +76,48 @@ def cmd_run(a: argparse.Namespace) -> int:
         if not a.concept:
             raise VCCError("give a PROGRAM, or --concept NAME to run its reference program")
         program = reference_program(a.concept)
+    given = [f for f, v in (("--scene", a.scene), ("--image", a.image), ("--example", a.example)) if v is not None]
+    if len(given) > 1:
+        raise VCCError(f"give one of {', '.join(given)}, not several")
+    if a.example is not None and not a.concept:
+        raise VCCError("--example K takes the K-th example pair of --concept NAME")
     if a.scene:
-        scene, note = Scene.load(a.scene).validate(cfg), f"scene {a.scene}"
-    else:
-        # a seeded random scene; with --concept, the first seed on which the concept does something
-        for seed in range(a.seed, a.seed + 500):
-            scene = random_scene(np.random.default_rng(seed), a.objects, pointer=True)
-            m = run_reference(program, scene, cfg)
-            if not a.concept or (not m.failed and not scenes_match(m.output_scene(), scene, cfg.tau)):
-                break
-        note = f"random scene, seed {seed}"
+        return program, Scene.load(a.scene).validate(cfg), f"scene {a.scene}", None
+    if a.image:
+        from vccjax.perception import parse_image
+
+        image = read_image(a.image)
+        try:
+            scene = parse_image(image).validate(cfg)
+        except VCCError as e:
+            raise VCCError(f"{a.image}: {e}") from None
+        return program, scene, f"image {a.image} ({len(scene.objects)} objects parsed)", None
+    if a.example is not None:
+        from vccjax.dataset import dataset_for
+
+        pairs = dataset_for([a.concept], 0, a.dataset, progress=False).pairs(a.concept, a.split)
+        if not 0 <= a.example < len(pairs):
+            raise VCCError(f"--example {a.example}: {a.concept} has {len(pairs)} {a.split} pairs "
+                           f"(0 to {len(pairs) - 1})")
+        scene, expected = pairs[a.example]
+        return program, scene, f"{a.split} example {a.example} of {a.concept}", expected
+    # a seeded random scene; with --concept, the first seed on which the concept does something
+    for seed in range(a.seed, a.seed + 500):
+        scene = random_scene(np.random.default_rng(seed), a.objects, pointer=True)
+        m = run_reference(program, scene, cfg)
+        if not a.concept or (not m.failed and not scenes_match(m.output_scene(), scene, cfg.tau)):
+            break
+    return program, scene, f"random scene, seed {seed}", None
+
+
+def cmd_run(a: argparse.Namespace) -> int:
+    from vccjax.emulator import run
+    from vccjax.reference import run_reference
+    from vccjax.scene import scenes_match
+    from vccjax.state import load_scene, output_scene
+
+    cfg = DEFAULT_CONFIG
+    program, scene, note, expected = program_and_scene(a)
     if a.engine == "reference":
         m = run_reference(program, scene, cfg)
         failed, index, reason, out = m.failed, m.fail_index, m.fail_reason, m.output_scene()
@@ -95,7 +140,31 @@ def cmd_run(a: argparse.Namespace) -> int:
     print("before:", *_legend(scene), sep="\n  ")
     print("after:", *_legend(out), sep="\n  ")
     print("changed" if not scenes_match(out, scene, cfg.tau) else "unchanged")
+    if expected is not None:
+        same = scenes_match(out, expected, cfg.tau)
+        print("the example's output: " + ("matched" if same else "NOT matched"))
+        return 0 if same else 1
     return 0
+
+
+def cmd_trace(a: argparse.Namespace) -> int:
+    from vccjax.trace import trace
+    from vccjax.viewer import write_trace
+
+    program, scene, note, _ = program_and_scene(a)
+    outs = [o for o in a.out.split(",") if o]
+    bad = [o for o in outs if Path(o).suffix.lower() not in (".png", ".gif")]
+    if bad or not outs:
+        raise VCCError(f"--out {a.out}: write a .png sheet or a .gif animation (or both, comma-separated)")
+    frames = trace(program, scene)
+    for out in outs:
+        write_trace(frames, out, size=a.size, columns=a.columns, seconds_per_step=a.seconds)
+    last = frames[-1]
+    status = (f"FAILED at instruction {last.pc} ({last.instruction}): {last.machine.fail_reason}"
+              if last.failed else "ran to the end")
+    print(f"{note}: {len(frames) - 1} instructions executed, {status}")
+    print("wrote " + ", ".join(outs))
+    return 1 if last.failed else 0
 
 
 def cmd_concepts(a: argparse.Namespace) -> int:
@@ -161,19 +230,40 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _scene_flags(p: argparse.ArgumentParser) -> None:
+    p.add_argument("program", nargs="?", help="program text or file (default: the concept's reference program)")
+    p.add_argument("--concept", help="one of the 546 concepts (see `vcc concepts`)")
+    p.add_argument("--scene", help="scene JSON file")
+    p.add_argument("--image", help="image file of a scene, parsed by the OpenCV perception")
+    p.add_argument("--example", type=int, help="the concept's K-th example pair: its input, checked against its output")
+    p.add_argument("--split", choices=["train", "test"], default="train", help="pairs of --example (default train)")
+    p.add_argument("--dataset", help="built dataset folder for --example (default: the shipped one)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random scene when none is given (default 0)")
+    p.add_argument("--objects", type=int, default=4, help="objects in the random scene (default 4)")
+
+
 def add_commands(sub) -> None:
-    """run, dataset, perception, concepts."""
+    """run, trace, dataset, perception, concepts."""
     r = sub.add_parser("run", help="run a program on a scene and print it before and after",
                        description="Run a VCC program (text like 'scene_parse; fixate(left); ...' "
                                    "or a .vcc file) on a scene and print it before and after.")
-    r.add_argument("program", nargs="?", help="program text or file (default: the concept's reference program)")
-    r.add_argument("--concept", help="one of the 546 concepts (see `vcc concepts`)")
-    r.add_argument("--scene", help="scene JSON file (default: a seeded random scene)")
-    r.add_argument("--seed", type=int, default=0, help="seed of the random scene (default 0)")
-    r.add_argument("--objects", type=int, default=4, help="objects in the random scene (default 4)")
+    _scene_flags(r)
     r.add_argument("--engine", choices=["jax", "reference"], default="jax",
                    help="the JAX emulator (default) or the scalar reference interpreter")
     r.set_defaults(fn=cmd_run)
+    t = sub.add_parser("trace", help="draw a program's run, one panel per executed instruction (PNG or GIF)",
+                       description="Run a program on the reference interpreter and draw every executed "
+                                   "instruction (loop iterations included): the blackboard and imagined "
+                                   "object, the fovea and its history, the hand and the held object, "
+                                   "attention (filters, attended list, the attended object boxed), and "
+                                   "the instruction with its argument; a failure is marked in red.")
+    _scene_flags(t)
+    t.add_argument("--out", required=True, help="trace.png (a sheet of panels) or trace.gif (animated); "
+                                                "both, comma-separated")
+    t.add_argument("--size", type=int, default=256, help="panel width in pixels (default 256)")
+    t.add_argument("--columns", type=int, default=6, help="panels per row of the PNG sheet (default 6)")
+    t.add_argument("--seconds", type=float, default=0.8, help="seconds per GIF frame (default 0.8)")
+    t.set_defaults(fn=cmd_trace)
     d = sub.add_parser("dataset", help="build or check the concepts' example pairs")
     dsub = d.add_subparsers(dest="action", required=True, metavar="ACTION")
     b = dsub.add_parser("build", help="generate 10 training and 50 test pairs per concept (resumable)")

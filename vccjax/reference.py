@@ -72,6 +72,7 @@ class RefMachine:
         self.in_loop = False
         self.loop_active = False
         self.body: list[tuple[int, int, int]] = []  # (op, arg, program index)
+        self.watch = None  # called as watch(machine, op, arg, pc) after each instruction (vccjax.trace)
 
     def clone(self) -> RefMachine:
         """An independent copy (the scene, read-only, is shared): a search keeps one per prefix."""
@@ -109,6 +110,8 @@ class RefMachine:
             self.execute(op, arg)
         except Failure as f:
             self.failed, self.fail_index, self.fail_reason = True, pc, str(f)
+        if self.watch is not None and (not self.failed or self.fail_index == pc):
+            self.watch(self, op, arg, pc)
 
     def execute(self, op: int, arg: int) -> None:
         name = NAMES[op]
@@ -399,6 +402,9 @@ class RefMachine:
                     self.execute(op, arg)
                 except Failure as f:
                     self.failed, self.fail_index, self.fail_reason = True, pc, str(f)
+                if self.watch is not None:
+                    self.watch(self, op, arg, pc)
+                if self.failed:
                     return
             iterations += 1
 

@@ -1,0 +1,165 @@
+"""Traces drawn: one panel per executed instruction, as a PNG sheet or an animated GIF.
+
+A panel shows the blackboard (the objects as the machine holds them, the pointer, the
+imagined object hatched in violet), the fovea (blue cross-hair ring) and its history
+(grey path, numbered), the hand (orange fork; the held object boxed in orange), and
+attention (the filters and attended list in the footer, each listed object numbered in
+magenta by its place in the list, the attended one boxed in magenta). The header names
+the instruction with its argument; a failed instruction turns the panel's frame red and
+its footer gives the reason.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from vccjax.geometry import imagined_pixels
+from vccjax.instructions import COLORS, SHAPES
+from vccjax.reference import RefMachine
+from vccjax.render import render
+from vccjax.scene import Scene
+from vccjax.trace import Frame
+
+HEADER, FOOTER, MARGIN = 34, 48, 6
+FONT = cv2.FONT_HERSHEY_SIMPLEX
+INK, GREY, RED = (30, 30, 30), (150, 150, 150), (210, 30, 30)
+FOVEA, HAND, ATTEND, IMAGINED = (40, 90, 230), (245, 140, 20), (220, 0, 200), (150, 90, 210)
+
+
+def _blackboard(m: RefMachine, input_frame: bool) -> Scene:
+    """What the machine holds (before scene_parse, or for the input panel: the scene)."""
+    return m.scene if input_frame or not m.parsed else m.output_scene()
+
+
+def _px(v: float, units: int, size: int) -> int:
+    return int(round(v / units * size))
+
+
+def _text(img: np.ndarray, text: str, org: tuple[int, int], color=INK, scale: float = 0.42) -> None:
+    cv2.putText(img, text, org, FONT, scale, color, 1, cv2.LINE_AA)
+
+
+def _fit(text: str, width: int, scale: float = 0.42) -> str:
+    """Cut `text` with an ellipsis to fit `width` pixels."""
+    while len(text) > 4 and cv2.getTextSize(text, FONT, scale, 1)[0][0] > width:
+        text = text[:-4] + "..."
+    return text
+
+
+def _box(img: np.ndarray, m: RefMachine, i: int, color, size: int, pad: int, thickness: int) -> None:
+    o, u = m.objects[i], m.cfg.units
+    h = o.width / 2 * size
+    x, y = _px(o.x, u, size), _px(o.y, u, size)
+    cv2.rectangle(img, (int(x - h) - pad, int(y - h) - pad), (int(x + h) + pad, int(y + h) + pad), color, thickness,
+                  cv2.LINE_AA)
+
+
+def _scene_view(m: RefMachine, size: int, input_frame: bool) -> np.ndarray:
+    img = render(_blackboard(m, input_frame), size=max(64, size)).copy()
+    u = m.cfg.units
+    if m.imagined is not None and not input_frame:  # hatched violet footprint
+        rows, cols = imagined_pixels(*m.imagined, m.cfg)
+        mask = np.zeros((m.cfg.raster, m.cfg.raster), np.uint8)
+        mask[rows, cols] = 1
+        mask = cv2.resize(mask, (size, size), interpolation=cv2.INTER_NEAREST).astype(bool)
+        yy, xx = np.mgrid[:size, :size]
+        hatch = ((xx + yy) // 3) % 3 == 0
+        img[mask] = (0.6 * img[mask] + 0.4 * np.array(IMAGINED)).astype(np.uint8)
+        img[mask & hatch] = IMAGINED
+    if input_frame or not m.parsed:
+        return img
+    pts = [(_px(x, u, size), _px(y, u, size)) for x, y in m.history]
+    if len(pts) > 1:
+        cv2.polylines(img, [np.array(pts, np.int32)], False, GREY, 1, cv2.LINE_AA)
+    for k, p in enumerate(pts[1:], 1):
+        cv2.circle(img, p, 2, GREY, -1, cv2.LINE_AA)
+        _text(img, str(k), (p[0] + 3, p[1] - 3), GREY, 0.3)
+    f = (_px(m.fovea[0], u, size), _px(m.fovea[1], u, size))
+    cv2.circle(img, f, 9, FOVEA, 2, cv2.LINE_AA)
+    cv2.line(img, (f[0] - 13, f[1]), (f[0] + 13, f[1]), FOVEA, 1, cv2.LINE_AA)
+    cv2.line(img, (f[0], f[1] - 13), (f[0], f[1] + 13), FOVEA, 1, cv2.LINE_AA)
+    for rank, i in enumerate(m.attended_list if not m.stale else []):
+        if m.objects[i].alive:
+            o = m.objects[i]
+            h = o.width / 2 * size
+            _text(img, str(rank + 1), (int(_px(o.x, u, size) + h) + 2, int(_px(o.y, u, size) - h) + 4), ATTEND, 0.38)
+    if m.attended is not None and m.objects[m.attended].alive:
+        _box(img, m, m.attended, ATTEND, size, 3, 1)
+    if m.held is not None:
+        _box(img, m, m.held, HAND, size, 6, 2)
+    hx, hy = _px(m.hand[0], u, size), _px(m.hand[1], u, size)  # a two-pronged fork, opening down
+    cv2.line(img, (hx - 7, hy - 12), (hx + 7, hy - 12), HAND, 2, cv2.LINE_AA)
+    cv2.line(img, (hx - 7, hy - 12), (hx - 7, hy - 2), HAND, 2, cv2.LINE_AA)
+    cv2.line(img, (hx + 7, hy - 12), (hx + 7, hy - 2), HAND, 2, cv2.LINE_AA)
+    cv2.line(img, (hx, hy - 12), (hx, hy - 20), HAND, 2, cv2.LINE_AA)
+    return img
+
+
+def panel(frame: Frame, size: int = 256) -> np.ndarray:
+    """One frame as an RGB image (size wide)."""
+    m, input_frame = frame.machine, frame.pc < 0
+    img = np.full((HEADER + size + FOOTER, size + 2 * MARGIN, 3), 255, np.uint8)
+    img[HEADER:HEADER + size, MARGIN:MARGIN + size] = _scene_view(m, size, input_frame)
+    cv2.rectangle(img, (MARGIN - 1, HEADER - 1), (MARGIN + size, HEADER + size), (200, 200, 200), 1)  # the workspace
+    width = size + 2 * MARGIN - 8
+    if input_frame:
+        _text(img, "input scene", (4, 14), INK, 0.45)
+    else:
+        loop = f", iteration {frame.iteration + 1}" if frame.iteration else ""
+        _text(img, f"step {frame.step + 1} (instruction {frame.pc}{loop})", (4, 13), GREY, 0.36)
+        _text(img, _fit(frame.instruction, width, 0.48), (4, 29), RED if frame.failed else INK, 0.48)
+    y = HEADER + size + 15
+    if frame.failed:
+        _text(img, _fit(f"FAILED: {m.fail_reason}", width), (4, y), RED)
+        _text(img, "the machine stops here", (4, y + 17), RED, 0.38)
+    elif not input_frame and m.parsed:
+        shape = "any" if m.shape_filter is None else SHAPES[m.shape_filter]
+        color = "any" if m.color_filter is None else COLORS[m.color_filter]
+        listed = "stale" if m.stale else f"{len(m.attended_list)} listed, at {m.k + 1}"
+        _text(img, _fit(f"attention: {shape} shape, {color} colour; {listed}", width), (4, y), ATTEND, 0.38)
+        held = "empty" if m.held is None else f"holds the {COLORS[m.objects[m.held].color]} " \
+                                                f"{SHAPES[m.objects[m.held].shape]}"
+        imagined = "" if m.imagined is None else "; imagining a " + ("circle" if m.imagined[0] == 0 else "line")
+        _text(img, _fit(f"hand {held}; fixations {len(m.history) - 1}{imagined}", width), (4, y + 17), INK, 0.38)
+    if frame.failed:
+        cv2.rectangle(img, (0, 0), (img.shape[1] - 1, img.shape[0] - 1), RED, 3)
+    return img
+
+
+def sheet(frames: Sequence[Frame], size: int = 256, columns: int = 6) -> np.ndarray:
+    """Every panel, left to right and top to bottom, on one RGB image."""
+    panels = [panel(f, size) for f in frames]
+    h, w = panels[0].shape[:2]
+    columns = max(1, min(columns, len(panels)))
+    rows = -(-len(panels) // columns)
+    out = np.full((rows * (h + 4), columns * (w + 4), 3), 235, np.uint8)
+    for k, p in enumerate(panels):
+        r, c = divmod(k, columns)
+        out[r * (h + 4):r * (h + 4) + h, c * (w + 4):c * (w + 4) + w] = p
+    return out
+
+
+def write_trace(frames: Sequence[Frame], path: str | Path, size: int = 256, columns: int = 6,
+                seconds_per_step: float = 0.8) -> Path:
+    """A PNG sheet (.png) or an animated GIF (.gif, one panel per frame, the last held)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".png", ".gif"):
+        raise ValueError(f"{path}: a trace is written as .png or .gif")
+    if not frames:
+        raise ValueError("no frames to draw")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".png":
+        if not cv2.imwrite(str(path), cv2.cvtColor(sheet(frames, size, columns), cv2.COLOR_RGB2BGR)):
+            raise OSError(f"{path}: could not be written")
+        return path
+    from PIL import Image  # Pillow: OpenCV writes no GIF
+
+    images = [Image.fromarray(panel(f, size)) for f in frames]
+    durations = [int(seconds_per_step * 1000)] * (len(images) - 1) + [int(seconds_per_step * 3000)]
+    images[0].save(path, save_all=True, append_images=images[1:], duration=durations, loop=0, optimize=True)
+    return path
