@@ -178,25 +178,24 @@ def test_video_of_a_rollout_is_written(bench, tmp_path):
     assert ok and frame.shape == (120, 212, 3)
 
 
-@pytest.mark.slow
-def test_a_thousand_random_rollouts_stay_finite(bench):
-    """1,000 rollouts of random arm-compatible concepts on random scenarios, 32 at a time
-    on MJX: every state finite, every scenario judged (about an hour on one core)."""
+def test_stress_batches_are_drawn_the_same_each_time():
+    """A resumed `vcc robot stress` redraws a batch from (seed, batch) alone."""
     from robot.scenario import arm_concepts
+    from robot.stress import draw_batch
 
-    rng = np.random.default_rng(7)
-    names = arm_concepts()
-    done = 0
-    while done < 1000:
-        items = []
-        while len(items) < 32:
-            c = names[int(rng.integers(len(names)))]
-            try:
-                program = reference_program(c)
-                items.append((program, draw(program, int(rng.integers(1 << 30)), max_tries=200)))
-            except Exception:  # a concept no scenario of these bodies lets run
-                continue
-        verdicts, info, kept = bench.run_pairs(items, keep=True)
-        assert all(q is None or np.isfinite(q).all() for q in kept)
-        assert len(verdicts) == 32 and all(v.cause in (None, *CAUSES) for v in verdicts)
-        done += 32
+    a, b, c = draw_batch(7, 3, size=4), draw_batch(7, 3, size=4), draw_batch(7, 4, size=4)
+    assert [(n, s.seed, s.slots) for n, _, s in a] == [(n, s.seed, s.slots) for n, _, s in b]
+    assert [s.seed for _, _, s in a] != [s.seed for _, _, s in c]
+    assert all(n in arm_concepts() for n, _, _ in a)
+
+
+@pytest.mark.slow
+def test_a_thousand_random_rollouts_stay_finite(tmp_path):
+    """1,000 rollouts of random arm-compatible concepts on random scenarios, 32 at a time
+    on MJX (`vcc robot stress`): every state finite, every scenario judged (about an hour
+    and a half on one core)."""
+    from robot.stress import run_stress
+
+    s = run_stress(tmp_path, rollouts=1000, seed=7, log=lambda _: None)
+    assert s["rollouts"] >= 1000 and s["non_finite"] == 0
+    assert s["rolled_out"] > 0.9 * s["rollouts"] and set(s["failures"]) <= set(CAUSES)
