@@ -20,12 +20,21 @@ def enable_compile_cache() -> None:
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
 
 
+DEMO: tuple[str, ...] = (  # a dozen short concepts: `--concepts demo` (all found in under a minute on 2 cores)
+    "change_target_obj_to_given_color", "change_target_position_to_given_color", "remove_bottom_obj",
+    "remove_given_target_color_objs", "remove_given_target_shape_objs", "remove_left_most_obj",
+    "remove_right_most_obj", "remove_top_obj", "remove_given_target_shape_and_color_combo_objs",
+    "move_to_bottom_edge", "move_to_right_edge", "move_to_top_edge")
+
+
 def concept_list(spec: str) -> list[str]:
     from vccjax.concepts import concept_names
 
     names = concept_names()
     if spec == "all":
         return names
+    if spec == "demo":
+        return list(DEMO)
     chosen = [c.strip() for c in spec.split(",") if c.strip()]
     unknown = [c for c in chosen if c not in names]
     if unknown:
@@ -74,7 +83,8 @@ def add_commands(sub) -> None:
                     "and repeat. Results go to OUT/results.jsonl after every concept; rerunning the same "
                     "command resumes.",
     )
-    p.add_argument("--concepts", default="all", help="'all' (default) or a comma-separated list")
+    p.add_argument("--concepts", default="all",
+                   help="'all' (default), 'demo' (a dozen short ones) or a comma-separated list")
     p.add_argument("--out", required=True, help="run folder (created; an existing one is resumed)")
     p.add_argument("--budget", type=int, default=500_000, help="programs per concept (default 500000)")
     p.add_argument("--order", type=int, choices=[0, 1], default=1, help="Markov order (default 1)")

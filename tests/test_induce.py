@@ -249,17 +249,11 @@ def test_cli_induce_refuses_a_dataset_without_the_concept_or_other_examples(tmp_
     assert "other examples for remove_bottom_obj" in err and len(err.splitlines()) == 1
 
 
-DOZEN = ["change_target_obj_to_given_color", "change_target_position_to_given_color", "remove_bottom_obj",
-         "remove_given_target_color_objs", "remove_given_target_shape_objs", "remove_left_most_obj",
-         "remove_right_most_obj", "remove_top_obj", "remove_given_target_shape_and_color_combo_objs",
-         "move_to_bottom_edge", "move_to_right_edge", "move_to_top_edge"]
-
-
 def test_cli_induces_a_dozen_short_concepts_end_to_end(tmp_path, capsys):
     """The CI-sized run: examples built, explore-compress over a dozen concepts, every
     found program checked on its 50 test pairs, the summary table printed."""
     out = tmp_path / "dozen"
-    argv = ["induce", "--concepts", ",".join(DOZEN), "--out", str(out), "--budget", "20000",
+    argv = ["induce", "--concepts", "demo", "--out", str(out), "--budget", "20000",
             "--iterations", "3", "--quiet"]
     assert main(argv) == 0
     text = capsys.readouterr().out

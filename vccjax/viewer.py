@@ -3,8 +3,9 @@
 A panel shows the blackboard (the objects as the machine holds them, the pointer, the
 imagined object hatched in violet), the fovea (blue cross-hair ring) and its history
 (grey path, numbered), the hand (orange fork; the held object boxed in orange), and
-attention (the filters and attended list in the footer, each listed object numbered in
-magenta by its place in the list, the attended one boxed in magenta). The header names
+attention (the footer's "attend shape/colour" filters, * for any, and the attended
+list; each listed object numbered in magenta by its place in the list, the attended
+one boxed in magenta). The header names
 the instruction with its argument; a failed instruction turns the panel's frame red and
 its footer gives the reason.
 """
@@ -117,14 +118,16 @@ def panel(frame: Frame, size: int = 256) -> np.ndarray:
         _text(img, _fit(f"FAILED: {m.fail_reason}", width), (4, y), RED)
         _text(img, "the machine stops here", (4, y + 17), RED, 0.38)
     elif not input_frame and m.parsed:
-        shape = "any" if m.shape_filter is None else SHAPES[m.shape_filter]
-        color = "any" if m.color_filter is None else COLORS[m.color_filter]
-        listed = "stale" if m.stale else f"{len(m.attended_list)} listed, at {m.k + 1}"
-        _text(img, _fit(f"attention: {shape} shape, {color} colour; {listed}", width), (4, y), ATTEND, 0.38)
-        held = "empty" if m.held is None else f"holds the {COLORS[m.objects[m.held].color]} " \
-                                                f"{SHAPES[m.objects[m.held].shape]}"
-        imagined = "" if m.imagined is None else "; imagining a " + ("circle" if m.imagined[0] == 0 else "line")
-        _text(img, _fit(f"hand {held}; fixations {len(m.history) - 1}{imagined}", width), (4, y + 17), INK, 0.38)
+        shape = "*" if m.shape_filter is None else SHAPES[m.shape_filter]
+        color = "*" if m.color_filter is None else COLORS[m.color_filter]
+        listed = "list stale" if m.stale else f"{len(m.attended_list)} listed, at {m.k + 1}"
+        _text(img, _fit(f"attend {shape}/{color}: {listed}", width), (4, y), ATTEND, 0.38)
+        o = None if m.held is None else m.objects[m.held]
+        held = "hand empty" if o is None else f"holds {COLORS[o.color]} {SHAPES[o.shape]}"
+        imagined = "" if m.imagined is None else ", imagining a " + ("circle" if m.imagined[0] == 0 else "line")
+        n = len(m.history) - 1
+        fixations = f"{n} fixation" + ("" if n == 1 else "s")
+        _text(img, _fit(f"{held}, {fixations}{imagined}", width), (4, y + 17), INK, 0.38)
     if frame.failed:
         cv2.rectangle(img, (0, 0), (img.shape[1] - 1, img.shape[0] - 1), RED, 3)
     return img
