@@ -12,6 +12,7 @@ import platform
 import subprocess
 import sys
 import time
+from collections import Counter
 from pathlib import Path
 
 
@@ -114,6 +115,69 @@ def cmd_bench_search(a: argparse.Namespace) -> int:
     return 0 if agree else 1
 
 
+def _ints(text: str) -> list[int]:
+    try:
+        return [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise ValueError(f"expected comma-separated integers, got {text!r}") from None
+
+
+def cmd_bench_emulator(a: argparse.Namespace) -> int:
+    """The search's instruction stream stepped by the batched JAX emulator and by the
+    reference interpreter from the same parent states: programs/s and their ratio, per
+    instruction too; sweeps over batch size, objects per scene and raster size."""
+    import numpy as np
+
+    from vcc import emulator_bench as eb
+    from vccjax.instructions import NAMES
+    from vccjax.config import DEFAULT_CONFIG, VCCConfig
+    from vccjax.generate import random_scene
+
+    batches, objects, rasters = _ints(a.batch), _ints(a.objects), _ints(a.raster)
+    a.sample = a.sample or 16
+    a.model = "reference"  # a late iteration's model: the deep, mixed stream of the search's later work
+    names, jobs = _search_jobs(a)
+    t0 = time.perf_counter()
+    stream = eb.record_stream(jobs, a.per_concept)
+    record_s = time.perf_counter() - t0
+    examples = [[x for x, _ in task.pairs] for _, task in jobs]
+    ops = Counter(NAMES[c[2]] for c in stream)
+
+    def run(scenes, cfg, batch):
+        return eb.measure(eb.prepare(stream, scenes, cfg), batch, a.repeats)
+
+    main = run(examples, DEFAULT_CONFIG, batches[0])
+    sweeps = {"batch": [main] + [run(examples, DEFAULT_CONFIG, b) for b in batches[1:]], "objects": [], "raster": []}
+    rng = np.random.default_rng(0)
+    for n in objects:
+        scenes = [[random_scene(rng, n, pointer=True) for _ in ex] for ex in examples]
+        sweeps["objects"].append({"objects": n, **run(scenes, DEFAULT_CONFIG, batches[0])})
+    for r in rasters:
+        sweeps["raster"].append({"raster": r, **run(examples, VCCConfig(raster=r), batches[0])})
+    report = {**stamp(), "benchmark": "emulator", "concepts": names, "model": "reference",
+              "stream": {"programs": len(stream), "per_concept": a.per_concept, "record_seconds": round(record_s, 2),
+                         "instructions": dict(ops.most_common())},
+              "main": main, "sweeps": sweeps}
+    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(a.out).write_text(json.dumps(report, indent=1))
+    every = [main] + sweeps["batch"][1:] + sweeps["objects"] + sweeps["raster"]
+    agree = all(m["agree"] for m in every)
+    print(f"{len(stream)} programs from the search of {len(names)} concepts ({len(ops)} instructions), "
+          f"each stepped on {main['examples']} examples; JAX and reference "
+          + ("agree on every one" if agree else "DISAGREE"))
+    print(f"{'setting':22}{'JAX prog/s':>12}{'ref prog/s':>12}{'ratio':>8}{'compile s':>11}")
+    for label, m in ([(f"batch {m['batch']}", m) for m in sweeps["batch"]]
+                     + [(f"{m['objects']} objects", m) for m in sweeps["objects"]]
+                     + [(f"raster {m['raster']}", m) for m in sweeps["raster"]]):
+        print(f"{label:22}{m['jax_programs_per_second']:>12}{m['reference_programs_per_second']:>12}"
+              f"{m['ratio']:>8}{m['first_pass_seconds_with_compile']:>11}")
+    print(f"per instruction (batch {main['batch']}):")
+    for name, r in sorted(main["per_instruction"].items(), key=lambda x: -x[1]["programs"]):
+        print(f"  {name:30}{r['programs']:>7}{r['jax_per_second']:>12}{r['reference_per_second']:>12}{r['ratio']:>8}")
+    print(f"ratio (reference time / JAX time), mixed stream: {main['ratio']}x   -> {a.out}")
+    return 0 if agree else 1
+
+
 def add_commands(sub) -> None:
     b = sub.add_parser("bench", help="benchmarks: measured speed, stamped with machine and commit")
     bsub = b.add_subparsers(dest="action", required=True, metavar="BENCHMARK")
@@ -132,3 +196,19 @@ def add_commands(sub) -> None:
     s.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
     s.add_argument("--out", default="benchmarks/results/search.json", help="result JSON")
     s.set_defaults(fn=cmd_bench_search)
+    e = bsub.add_parser("emulator", help="batched JAX emulator vs reference interpreter on a search's stream",
+                        description="Record the children a real search steps (the scalar-driven search of "
+                                    "--sample concepts under a late iteration's model), then step each by its "
+                                    "last instruction from the same parent states on both machines: programs/s, "
+                                    "per instruction and overall, and their ratio in the same run. Sweeps over "
+                                    "batch size, objects per scene and raster size; compile time apart.")
+    e.add_argument("--concepts", help="comma-separated concepts (default: --sample spread over all 546)")
+    e.add_argument("--sample", type=int, default=16, help="concepts, evenly spread (default 16)")
+    e.add_argument("--per-concept", type=int, default=500, help="children recorded per concept (default 500)")
+    e.add_argument("--batch", default="256,1024,4096", help="rows per device call; the first is the main one")
+    e.add_argument("--objects", default="2,5,8", help="objects per random scene for the objects sweep")
+    e.add_argument("--raster", default="32,128", help="raster sizes for the raster sweep (the default is 64)")
+    e.add_argument("--repeats", type=int, default=3, help="timed passes (the best is kept)")
+    e.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
+    e.add_argument("--out", default="benchmarks/results/emulator.json", help="result JSON")
+    e.set_defaults(fn=cmd_bench_emulator)
