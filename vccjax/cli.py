@@ -232,12 +232,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _scene_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument("program", nargs="?", help="program text or file (default: the concept's reference program)")
-    p.add_argument("--concept", help="one of the 546 concepts (see `vcc concepts`)")
-    p.add_argument("--scene", help="scene JSON file")
-    p.add_argument("--image", help="image file of a scene, parsed by the OpenCV perception")
-    p.add_argument("--example", type=int, help="the concept's K-th example pair: its input, checked against its output")
+    p.add_argument("--concept", metavar="NAME", help="one of the 546 concepts (see `vcc concepts`)")
+    p.add_argument("--scene", metavar="FILE", help="scene JSON file")
+    p.add_argument("--image", metavar="FILE", help="image file of a scene, parsed by the OpenCV perception")
+    p.add_argument("--example", type=int, metavar="K",
+                   help="the concept's K-th example pair: its input, checked against its output")
     p.add_argument("--split", choices=["train", "test"], default="train", help="pairs of --example (default train)")
-    p.add_argument("--dataset", help="built dataset folder for --example (default: the shipped one)")
+    p.add_argument("--dataset", metavar="DIR", help="built dataset folder for --example (default: the shipped one)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random scene when none is given (default 0)")
     p.add_argument("--objects", type=int, default=4, help="objects in the random scene (default 4)")
 
