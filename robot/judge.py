@@ -106,3 +106,12 @@ def judge(model: mujoco.MjModel, prepared, qs: np.ndarray | None) -> Verdict:
     if worst > TOLERANCE:
         return Verdict(False, "misplaced", f"an object ended {worst * 100:.1f} cm from its place", worst, seed)
     return Verdict(True, None, f"largest error {worst * 100:.1f} cm", worst, seed)
+
+
+def tally(verdicts: list[Verdict]) -> dict:
+    """Successes, failures by cause, and every verdict: what a result file keeps."""
+    from collections import Counter
+
+    return {"success": sum(v.success for v in verdicts),
+            "failures": dict(Counter(v.cause for v in verdicts if not v.success)),
+            "verdicts": [v.__dict__ for v in verdicts]}

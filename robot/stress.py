@@ -40,7 +40,9 @@ def run_stress(out: str | Path, rollouts: int = 1000, seed: int = 7, log=print) 
     summary, also written there as summary.json."""
     from tqdm import tqdm
 
+    from robot.judge import tally
     from robot.rollout import Bench
+    from robot.suite import write_record
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -59,12 +61,8 @@ def run_stress(out: str | Path, rollouts: int = 1000, seed: int = 7, log=print) 
         record = {"batch": b, "seed": seed, "timing": info,
                   "concepts": [n for n, _, _ in items], "scenario_seeds": [s.seed for _, _, s in items],
                   "rolled_out": sum(q is not None for q in kept), "non_finite": finite.count(False),
-                  "success": sum(v.success for v in verdicts),
-                  "failures": dict(Counter(v.cause for v in verdicts if not v.success)),
-                  "verdicts": [v.__dict__ for v in verdicts]}
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(record, indent=1))
-        tmp.replace(path)
+                  **tally(verdicts)}
+        write_record(path, record)
         log(f"batch {b}: {record['success']} of {len(items)} carried out, "
             f"{record['non_finite']} non-finite, wall {info['wall_s']:.0f} s")
     rows = [json.loads((out / f"batch-{b:03d}.json").read_text()) for b in range(batches)]

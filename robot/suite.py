@@ -36,10 +36,18 @@ def programs_of(name: str):
     return programs[0] if len(programs) == 1 else programs
 
 
+def write_record(path: Path, record: dict) -> None:
+    """Whole or not at all, if the run is killed while writing (a resume trusts it)."""
+    tmp = path.with_suffix(".tmp")
+    tmp.write_text(json.dumps(record, indent=1))
+    tmp.replace(path)
+
+
 def run_suite(out: str | Path, scenarios: int = 32, seed: int = 0, concepts=SUITE, log=print) -> dict:
     """Run (or resume) the suite into `out`; returns the summary (also written there)."""
     from tqdm import tqdm
 
+    from robot.judge import tally
     from robot.rollout import Bench, scenarios_for
 
     out = Path(out)
@@ -54,13 +62,8 @@ def run_suite(out: str | Path, scenarios: int = 32, seed: int = 0, concepts=SUIT
         start = time.perf_counter()
         verdicts, info, _ = bench.run(programs, scenarios_for(programs, scenarios, seed))
         info["wall_s"] = time.perf_counter() - start
-        record = {"concept": name, "scenarios": scenarios, "seed": seed, "timing": info,
-                  "success": sum(v.success for v in verdicts),
-                  "failures": dict(Counter(v.cause for v in verdicts if not v.success)),
-                  "verdicts": [v.__dict__ for v in verdicts]}
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(record, indent=1))
-        tmp.replace(path)
+        record = {"concept": name, "scenarios": scenarios, "seed": seed, "timing": info, **tally(verdicts)}
+        write_record(path, record)
         log(f"{name}: {record['success']} of {scenarios}, wall {info['wall_s']:.0f} s")
     rows = [json.loads(p.read_text()) for p in sorted(out.glob("*.json")) if p.name != "summary.json"]
     total = sum(r["scenarios"] for r in rows)

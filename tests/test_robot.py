@@ -199,3 +199,30 @@ def test_a_thousand_random_rollouts_stay_finite(tmp_path):
     s = run_stress(tmp_path, rollouts=1000, seed=7, log=lambda _: None)
     assert s["rollouts"] >= 1000 and s["non_finite"] == 0
     assert s["rolled_out"] > 0.9 * s["rollouts"] and set(s["failures"]) <= set(CAUSES)
+
+
+def test_suite_writes_one_record_per_concept_and_resumes_without_redoing(tmp_path, monkeypatch):
+    """`vcc robot suite`: a finished concept's record is kept; a rerun does only what is left."""
+    import json
+
+    import robot.rollout
+    from robot.judge import Verdict
+    from robot.suite import run_suite
+
+    calls = []
+
+    class FakeBench:
+        def run(self, programs, scenarios, keep=False):
+            calls.append(len(scenarios))
+            vs = [Verdict(k % 2 == 0, None if k % 2 == 0 else "object dropped", "", 0.0, s.seed)
+                  for k, s in enumerate(scenarios)]
+            return vs, {"compile_s": 0.0, "rollout_s": 0.0}, []
+
+    monkeypatch.setattr(robot.rollout, "Bench", FakeBench)
+    two = ("move_bottom_to_pointed", "move_green_to_right_bottom_corner")
+    s = run_suite(tmp_path, scenarios=4, concepts=two[:1], log=lambda _: None)
+    assert calls == [4] and s["success"] == 2 and s["failures"] == {"object dropped": 2}
+    s = run_suite(tmp_path, scenarios=4, concepts=two, log=lambda _: None)
+    assert calls == [4, 4] and s["concepts"] == 2 and s["rollouts"] == 8  # the first was not redone
+    record = json.loads((tmp_path / "move_bottom_to_pointed.json").read_text())
+    assert record["success"] == 2 and len(record["verdicts"]) == 4 and not list(tmp_path.glob("*.tmp"))

@@ -93,8 +93,8 @@ def cmd_bench_search(a: argparse.Namespace) -> int:
                 "programs_run": sum(r.programs for r in results.values()),
                 "programs_per_second": round(covered / seconds), "nodes_per_second": round(nodes / seconds)}
 
-    agree = all((batched[j].found, batched[j].text, batched[j].rank) == (scalar[j].found, scalar[j].text, scalar[j].rank)
-                for j in range(len(jobs)))
+    agree = all((batched[j].found, batched[j].text, batched[j].rank) == (scalar[j].found, scalar[j].text,
+                                                                         scalar[j].rank) for j in range(len(jobs)))
     report = {
         **stamp(), "benchmark": "search", "concepts": names, "budget": a.budget, "model": a.model,
         "args": "oracle", "width": a.width, "found": sum(r.found for r in batched.values()),
@@ -134,7 +134,6 @@ def cmd_bench_emulator(a: argparse.Namespace) -> int:
     from vccjax.generate import random_scene
 
     batches, objects, rasters = _ints(a.batch), _ints(a.objects), _ints(a.raster)
-    a.sample = a.sample or 16
     a.model = "reference"  # a late iteration's model: the deep, mixed stream of the search's later work
     names, jobs = _search_jobs(a)
     t0 = time.perf_counter()
@@ -178,6 +177,12 @@ def cmd_bench_emulator(a: argparse.Namespace) -> int:
     return 0 if agree else 1
 
 
+def _concept_flags(p: argparse.ArgumentParser, sample: int) -> None:
+    p.add_argument("--concepts", help="comma-separated concepts (default: --sample spread over all 546)")
+    p.add_argument("--sample", type=int, default=sample, help=f"concepts, evenly spread (default {sample})")
+    p.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
+
+
 def add_commands(sub) -> None:
     b = sub.add_parser("bench", help="benchmarks: measured speed, stamped with machine and commit")
     bsub = b.add_subparsers(dest="action", required=True, metavar="BENCHMARK")
@@ -186,14 +191,12 @@ def add_commands(sub) -> None:
                                     "in lockstep on the JAX emulator) and with the scalar reference "
                                     "interpreter; print programs/s (counted as the paper counts them) "
                                     "and the ratio. Compile time is measured apart (a first run).")
-    s.add_argument("--concepts", help="comma-separated concepts (default: --sample spread over all 546)")
-    s.add_argument("--sample", type=int, default=64, help="concepts, evenly spread (default 64)")
+    _concept_flags(s, 64)
     s.add_argument("--budget", type=int, default=100_000, help="programs per concept (default 100000)")
     s.add_argument("--model", choices=["uniform", "reference"], default="uniform",
                    help="uniform: explore-compress iteration 0; reference: an order-1 model fitted "
                         "on the reference programs, standing in for a late iteration (deeper trees)")
     s.add_argument("--width", type=int, default=32, help="concepts in lockstep (default 32)")
-    s.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
     s.add_argument("--out", default="benchmarks/results/search.json", help="result JSON")
     s.set_defaults(fn=cmd_bench_search)
     e = bsub.add_parser("emulator", help="batched JAX emulator vs reference interpreter on a search's stream",
@@ -202,13 +205,11 @@ def add_commands(sub) -> None:
                                     "last instruction from the same parent states on both machines: programs/s, "
                                     "per instruction and overall, and their ratio in the same run. Sweeps over "
                                     "batch size, objects per scene and raster size; compile time apart.")
-    e.add_argument("--concepts", help="comma-separated concepts (default: --sample spread over all 546)")
-    e.add_argument("--sample", type=int, default=16, help="concepts, evenly spread (default 16)")
+    _concept_flags(e, 16)
     e.add_argument("--per-concept", type=int, default=500, help="children recorded per concept (default 500)")
-    e.add_argument("--batch", default="256,1024,4096", help="rows per device call; the first is the main one")
+    e.add_argument("--batch", default="1024,4096", help="rows per device call; the first is the main one")
     e.add_argument("--objects", default="2,5,8", help="objects per random scene for the objects sweep")
     e.add_argument("--raster", default="32,128", help="raster sizes for the raster sweep (the default is 64)")
     e.add_argument("--repeats", type=int, default=3, help="timed passes (the best is kept)")
-    e.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
     e.add_argument("--out", default="benchmarks/results/emulator.json", help="result JSON")
     e.set_defaults(fn=cmd_bench_emulator)
