@@ -19,7 +19,7 @@ def _program(a: argparse.Namespace):
         return parse(text)
     from robot.suite import programs_of
 
-    return programs_of(a.concept)
+    return programs_of(a.concept, a.induced)
 
 
 def cmd_run(a: argparse.Namespace) -> int:
@@ -79,7 +79,7 @@ def cmd_suite(a: argparse.Namespace) -> int:
     _setup_mjx(a)
     from robot.suite import run_suite
 
-    s = run_suite(a.out, a.scenarios, a.seed)
+    s = run_suite(a.out, a.scenarios, a.seed, induced=a.induced)
     for name, rate in s["per_concept"].items():
         print(f"{rate:7.1%}  {name}")
     print("failures: " + (", ".join(f"{c} {n}" for c, n in s["failures"].items()) or "none"))
@@ -110,6 +110,8 @@ def add_commands(sub) -> None:
     r.add_argument("--concept", required=True,
                    help="concept name (its reference program, unless --program); A+B composes two concepts")
     r.add_argument("--program", help="program text or file to run instead of the reference program")
+    r.add_argument("--induced", metavar="RUN",
+                   help="take the concept's program from this `vcc induce` run folder (default: the reference)")
     r.add_argument("--scenarios", type=int, default=32, help="randomized scenarios (default 32)")
     r.add_argument("--seed", type=int, default=0)
     r.add_argument("--video", help="write one rollout as a video (.mp4 or .avi)")
@@ -120,6 +122,8 @@ def add_commands(sub) -> None:
 
     u = s.add_parser("suite", help="the ten-concept benchmark, resumable (one JSON per concept)")
     u.add_argument("--out", required=True, help="results folder (an existing one is resumed)")
+    u.add_argument("--induced", metavar="RUN",
+                   help="the programs a `vcc induce` run found (its folder) instead of the reference ones")
     u.add_argument("--scenarios", type=int, default=32)
     u.add_argument("--seed", type=int, default=0)
     u.add_argument("--all-cores", action="store_true", help="let XLA use every core")

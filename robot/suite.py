@@ -24,15 +24,42 @@ SUITE: tuple[str, ...] = (
 )
 
 
-def programs_of(name: str):
-    """A concept's reference program; for A+B, A's then B's (run on the scene A leaves)."""
+def induced_programs(run: str | Path) -> dict:
+    """{concept: Program} a `vcc induce` run found (its results.jsonl; a later record wins)."""
+    from vccjax.errors import DataFileError
+    from vccjax.program import parse
+
+    path = Path(run) / "results.jsonl"
+    if not path.is_file():
+        raise DataFileError(f"{path}: missing (give the folder of a `vcc induce` run)")
+    found = {}
+    for k, line in enumerate(path.read_text().splitlines()):
+        try:
+            r = json.loads(line)
+            if r["found"]:
+                found[r["concept"]] = parse(r["program"])
+        except (ValueError, KeyError, TypeError) as e:
+            raise DataFileError(f"{path}: line {k + 1} is not a result of `vcc induce` ({e})") from None
+    return found
+
+
+def programs_of(name: str, induced: str | Path | None = None):
+    """A concept's program: the reference one, or the one a `vcc induce` run in folder
+    `induced` found; for A+B, A's then B's (run on the scene A leaves)."""
     from vccjax.concepts import concept_names, reference_program
 
     parts = name.split("+")
     unknown = [c for c in parts if c not in concept_names()]
     if unknown:
         raise ValueError(f"unknown concept {', '.join(map(repr, unknown))} (see `vcc concepts`)")
-    programs = [reference_program(c) for c in parts]
+    if induced is None:
+        programs = [reference_program(c) for c in parts]
+    else:
+        found = induced_programs(induced)
+        missing = [c for c in parts if c not in found]
+        if missing:
+            raise ValueError(f"{', '.join(missing)}: not induced in {induced}")
+        programs = [found[c] for c in parts]
     return programs[0] if len(programs) == 1 else programs
 
 
@@ -43,8 +70,10 @@ def write_record(path: Path, record: dict) -> None:
     tmp.replace(path)
 
 
-def run_suite(out: str | Path, scenarios: int = 32, seed: int = 0, concepts=SUITE, log=print) -> dict:
-    """Run (or resume) the suite into `out`; returns the summary (also written there)."""
+def run_suite(out: str | Path, scenarios: int = 32, seed: int = 0, concepts=SUITE, log=print,
+              induced: str | Path | None = None) -> dict:
+    """Run (or resume) the suite into `out` (reference programs, or those of the `vcc
+    induce` run in folder `induced`); returns the summary (also written there)."""
     from tqdm import tqdm
 
     from robot.judge import tally
@@ -58,11 +87,14 @@ def run_suite(out: str | Path, scenarios: int = 32, seed: int = 0, concepts=SUIT
         if path.exists() and json.loads(path.read_text()).get("scenarios") == scenarios:
             continue
         bench = bench or Bench()
-        programs = programs_of(name)
+        programs = programs_of(name, induced)
         start = time.perf_counter()
         verdicts, info, _ = bench.run(programs, scenarios_for(programs, scenarios, seed))
         info["wall_s"] = time.perf_counter() - start
-        record = {"concept": name, "scenarios": scenarios, "seed": seed, "timing": info, **tally(verdicts)}
+        texts = [p.text() for p in (programs if isinstance(programs, list) else [programs])]
+        record = {"concept": name, "scenarios": scenarios, "seed": seed, "programs": texts,
+                  "source": "reference" if induced is None else f"induced: {induced}", "timing": info,
+                  **tally(verdicts)}
         write_record(path, record)
         log(f"{name}: {record['success']} of {scenarios}, wall {info['wall_s']:.0f} s")
     rows = [json.loads(p.read_text()) for p in sorted(out.glob("*.json")) if p.name != "summary.json"]

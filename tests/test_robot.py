@@ -226,3 +226,25 @@ def test_suite_writes_one_record_per_concept_and_resumes_without_redoing(tmp_pat
     assert calls == [4, 4] and s["concepts"] == 2 and s["rollouts"] == 8  # the first was not redone
     record = json.loads((tmp_path / "move_bottom_to_pointed.json").read_text())
     assert record["success"] == 2 and len(record["verdicts"]) == 4 and not list(tmp_path.glob("*.tmp"))
+
+
+def test_programs_come_from_an_induce_run_when_asked(tmp_path):
+    import json
+
+    from robot.suite import programs_of
+    from vccjax.errors import DataFileError
+
+    found = ("scene_parse; fixate(bottom); top_down_attend; move_hand_to_attended_object; grab_object; "
+             "move_hand_to_pointer")  # no release: the arm puts the object down at the end
+    lines = [{"concept": "move_bottom_to_pointed", "found": False, "program": None},
+             {"concept": "move_bottom_to_pointed", "found": True, "program": found}]
+    (tmp_path / "results.jsonl").write_text("".join(json.dumps(x) + "\n" for x in lines))
+    assert programs_of("move_bottom_to_pointed", tmp_path).text() == found
+    assert programs_of("move_bottom_to_pointed") == reference_program("move_bottom_to_pointed")
+    with pytest.raises(ValueError, match="move_to_middle: not induced in"):
+        programs_of("move_bottom_to_pointed+move_to_middle", tmp_path)
+    with pytest.raises(DataFileError, match="results.jsonl: missing"):
+        programs_of("move_bottom_to_pointed", tmp_path / "none")
+    (tmp_path / "results.jsonl").write_text("{not json\n")
+    with pytest.raises(DataFileError, match="line 1 is not a result"):
+        programs_of("move_bottom_to_pointed", tmp_path)
