@@ -42,7 +42,7 @@ def run_stress(out: str | Path, rollouts: int = 1000, seed: int = 7, log=print) 
 
     from robot.judge import tally
     from robot.rollout import Bench
-    from robot.suite import write_record
+    from robot.suite import finished, write_record
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -50,7 +50,7 @@ def run_stress(out: str | Path, rollouts: int = 1000, seed: int = 7, log=print) 
     bench = None
     for b in tqdm(range(batches), desc="robot stress", unit="batch"):
         path = out / f"batch-{b:03d}.json"
-        if path.exists() and json.loads(path.read_text()).get("seed") == seed:
+        if finished(path, seed=seed):
             continue
         bench = bench or Bench()
         items = draw_batch(seed, b)

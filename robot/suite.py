@@ -63,6 +63,15 @@ def programs_of(name: str, induced: str | Path | None = None):
     return programs[0] if len(programs) == 1 else programs
 
 
+def finished(path: Path, **expected) -> bool:
+    """Whether `path` holds a record made with these settings (a resume keeps it; one
+    made with other settings is redone, not mixed in)."""
+    if not path.exists():
+        return False
+    record = json.loads(path.read_text())
+    return all(record.get(k) == v for k, v in expected.items())
+
+
 def write_record(path: Path, record: dict) -> None:
     """Whole or not at all, if the run is killed while writing (a resume trusts it)."""
     tmp = path.with_suffix(".tmp")
@@ -84,7 +93,8 @@ def run_suite(out: str | Path, scenarios: int = 32, seed: int = 0, concepts=SUIT
     bench = None
     for name in tqdm(concepts, desc="robot suite", unit="concept"):
         path = out / f"{name.replace('<', '').replace('>', '').replace('+', '_then_')}.json"
-        if path.exists() and json.loads(path.read_text()).get("scenarios") == scenarios:
+        source = "reference" if induced is None else f"induced: {induced}"
+        if finished(path, scenarios=scenarios, seed=seed, source=source):
             continue
         bench = bench or Bench()
         programs = programs_of(name, induced)
@@ -93,7 +103,7 @@ def run_suite(out: str | Path, scenarios: int = 32, seed: int = 0, concepts=SUIT
         info["wall_s"] = time.perf_counter() - start
         texts = [p.text() for p in (programs if isinstance(programs, list) else [programs])]
         record = {"concept": name, "scenarios": scenarios, "seed": seed, "programs": texts,
-                  "source": "reference" if induced is None else f"induced: {induced}", "timing": info,
+                  "source": source, "timing": info,
                   **tally(verdicts)}
         write_record(path, record)
         log(f"{name}: {record['success']} of {scenarios}, wall {info['wall_s']:.0f} s")

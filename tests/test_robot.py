@@ -226,6 +226,8 @@ def test_suite_writes_one_record_per_concept_and_resumes_without_redoing(tmp_pat
     assert calls == [4, 4] and s["concepts"] == 2 and s["rollouts"] == 8  # the first was not redone
     record = json.loads((tmp_path / "move_bottom_to_pointed.json").read_text())
     assert record["success"] == 2 and len(record["verdicts"]) == 4 and not list(tmp_path.glob("*.tmp"))
+    run_suite(tmp_path, scenarios=4, seed=1, concepts=two[:1], log=lambda _: None)
+    assert calls == [4, 4, 4]  # another seed is another run: redone, not kept
 
 
 def test_programs_come_from_an_induce_run_when_asked(tmp_path):
