@@ -28,7 +28,7 @@ from vccjax.instructions import NAMES, OP
 from vccjax.program import Program
 from vccjax.reference import RefMachine
 from vccjax.scene import Scene, scenes_match
-from vccjax.state import load_scene, output_scene, stack
+from vccjax.state import init_state, load_scene, output_scene, stack
 
 
 class _Enough(Exception):
@@ -103,7 +103,7 @@ def prepare(children, scenes: list[list[Scene]], cfg: VCCConfig) -> Prepared:
                 ops, args, _ = prefix.arrays(length)
                 cache_jax[key] = run_batch(cfg, consts_k[j], jnp.asarray(ops), jnp.asarray(args))
             else:
-                cache_jax[key] = jax.vmap(lambda _: _init(cfg))(jnp.arange(len(scenes[j])))
+                cache_jax[key] = jax.vmap(lambda _: init_state(cfg))(jnp.arange(len(scenes[j])))
         refs.append(cache_ref[key])
         jax_rows.append(cache_jax[key])
     groups = {}
@@ -116,12 +116,6 @@ def prepare(children, scenes: list[list[Scene]], cfg: VCCConfig) -> Prepared:
             "states": jax.tree.map(lambda *x: jnp.stack(x), *[jax_rows[r] for r in rows]),
         }
     return Prepared(cfg, scenes, list(children), refs, consts, groups)
-
-
-def _init(cfg):
-    from vccjax.state import init_state
-
-    return init_state(cfg)
 
 
 BUCKETS = (16, 64, 256, 1024, 4096)  # the search's padded batch sizes
