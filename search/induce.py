@@ -144,17 +144,19 @@ class Run:
         self.session = len(info["sessions"]) - 1
         self._write_meta(info)
         self.results_path = self.out / "results.jsonl"
-        self.records: list[dict] = []
+        self.records = read_records(self.results_path)
         if self.results_path.exists():
-            lines = self.results_path.read_text().splitlines()
-            for i, line in enumerate(lines):
-                try:
-                    self.records.append(json.loads(line))
-                except json.JSONDecodeError:
-                    if i == len(lines) - 1:  # a line cut by an interrupt: drop it, redo that concept
-                        break
-                    raise DataFileError(f"{self.results_path}: line {i + 1} is not JSON") from None
             self.results_path.write_text("".join(json.dumps(r) + "\n" for r in self.records))
+
+    @classmethod
+    def view(cls, out: str | Path) -> Run:
+        """A run folder read as it is (another process may be writing it): no session is
+        recorded and nothing is rewritten."""
+        run = cls.__new__(cls)
+        run.out, run.results_path = Path(out), Path(out) / "results.jsonl"
+        run.settings = None
+        run.records = read_records(run.results_path)
+        return run
 
     def check_examples(self, hashes: dict[str, str]) -> None:
         """Record each concept's examples hash; refuse a resume on other examples (a
@@ -190,6 +192,23 @@ class Run:
         with self.results_path.open("a") as f:
             f.write(json.dumps(record) + "\n")
             f.flush()
+
+
+def read_records(path: Path) -> list[dict]:
+    """A results file's records; a last line cut by an interrupt is dropped (that concept
+    is redone), any other bad line is an error."""
+    records: list[dict] = []
+    if not path.exists():
+        return records
+    lines = path.read_text().splitlines()
+    for i, line in enumerate(lines):
+        try:
+            records.append(json.loads(line))
+        except json.JSONDecodeError:
+            if i == len(lines) - 1:
+                break
+            raise DataFileError(f"{path}: line {i + 1} is not JSON") from None
+    return records
 
 
 def _record(concept: str, it: int, r: Result, test: tuple[int, int] | None) -> dict:

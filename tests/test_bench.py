@@ -54,3 +54,59 @@ def test_the_recorded_stream_is_what_the_search_steps_first():
     stream = record_stream([(chain, Task.from_pairs(ds.pairs("remove_bottom_obj", "train")))], 50)
     assert len(stream) == 50 and stream[0][1].ops == () and stream[0][2] == OP["scene_parse"]
     assert all(len(p) == 0 or p.ops[0] == OP["scene_parse"] for _, p, _, _ in stream)
+
+
+def _reproduce(tmp_path, *more):
+    return ["bench", "reproduce", "--concepts", "remove_bottom_obj,swap_locations", "--scale", "0.002",
+            "--width", "2", "--quiet", "--runs", str(tmp_path / "runs"), "--out", str(tmp_path / "res" / "r.json"),
+            "--report", str(tmp_path / "REPORT.md"), *more]
+
+
+def test_bench_reproduce_runs_rows_resumes_and_reports_the_rest_as_not_run(tmp_path, capsys):
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M,examples-2")) == 0
+    runs = tmp_path / "runs"
+    main_row, curve = runs / "o1-predfix-0.5M-2concepts-x0.002", runs / "examples-2-2concepts-x0.002"
+    s = json.loads((main_row / "summary.json").read_text())
+    assert s["complete"] and s["concepts"] == 2 and s["found"] >= 1 and s["row"] == "o1-predfix-0.5M"
+    assert json.loads((main_row / "run.json").read_text())["settings"]["budget"] == 1000  # 0.5M x 0.002
+    # the learning curve: short concepts only (swap_locations has 23 instructions), 2 training pairs
+    c = json.loads((curve / "run.json").read_text())
+    assert list(c["examples_sha256"]) == ["remove_bottom_obj"] and c["examples_sha256"]["remove_bottom_obj"].endswith(
+        ":first2")
+    r = json.loads((tmp_path / "res" / "r.json").read_text())
+    assert {"date", "commit", "machine", "command"} <= set(r) and set(r["rows"]) == {main_row.name, curve.name}
+    report = (tmp_path / "REPORT.md").read_text()
+    assert f"| {s['found']} of 2 | " in report and f"`{main_row.name}`" in report
+    assert "| o1-uniform-0.5M |" in report and report.count("not run") >= 10  # rows not run say so
+    # rerunning resumes: nothing is searched again
+    lines = (main_row / "results.jsonl").read_text()
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M")) == 0
+    assert (main_row / "results.jsonl").read_text() == lines
+
+
+def test_bench_report_reads_result_files_and_marks_a_partial_row(tmp_path, capsys):
+    import shutil
+    from pathlib import Path
+
+    res = tmp_path / "res"
+    res.mkdir()
+    shutil.copy(Path(__file__).parent.parent / "benchmarks" / "results" / "emulator-8x1000.json", res)
+    partial = tmp_path / "runs" / "o1-uniform-0.5M"
+    partial.mkdir(parents=True)
+    (partial / "run.json").write_text(json.dumps({"settings": {}, "examples_sha256": {"a": "x", "b": "y"}}))
+    (partial / "results.jsonl").write_text(json.dumps({
+        "concept": "a", "found": True, "iteration": 0, "program": "scene_parse; top_down_attend", "covered": 5,
+        "programs_run": 5, "nodes": 5, "seconds": 1.0, "test_correct": 50, "test_total": 50}) + "\n{cut")
+    assert main(["bench", "report", "--runs", str(tmp_path / "runs"), "--out", str(res / "r.json"),
+                 "--report", str(tmp_path / "REPORT.md")]) == 0
+    report = (tmp_path / "REPORT.md").read_text()
+    assert "| JAX emulator >= 20x the reference, mixed stream | 4.38x (`emulator-8x1000.json`) | no |" in report
+    assert "1 of 2 (partial: run interrupted, resumable)" in report
+    assert "commit d77a0f5" in report  # each table names its file's stamp
+
+
+def test_bench_reproduce_refuses_an_unknown_row_or_scale(tmp_path, capsys):
+    assert main(_reproduce(tmp_path, "--rows", "o2-magic")) == 2
+    assert "unknown row(s): o2-magic" in capsys.readouterr().err
+    assert main(_reproduce(tmp_path, "--rows", "examples-1", "--scale", "0")) == 2
+    assert "--scale must be positive" in capsys.readouterr().err

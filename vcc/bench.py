@@ -177,6 +177,64 @@ def cmd_bench_emulator(a: argparse.Namespace) -> int:
     return 0 if agree else 1
 
 
+def cmd_bench_reproduce(a: argparse.Namespace) -> int:
+    """Run the chosen rows (each resumable), then write the results JSON and the report."""
+    from search.cli import concept_list, enable_compile_cache
+    from vcc import reproduce as rp
+
+    rows = rp.select(a.rows)
+    if a.list:
+        for r in rp.ROWS:
+            print(f"{r.name:22}{r.what}   [paper: {r.paper}]")
+        return 0
+    if a.scale <= 0:
+        raise ValueError(f"--scale must be positive, got {a.scale}")
+    names = concept_list(a.concepts)
+    tag = "" if a.concepts == "all" else ("demo" if a.concepts == "demo" else f"{len(names)}concepts")
+    runs = Path(a.runs)
+    if rows:
+        enable_compile_cache()
+    interrupted = False
+    for k, row in enumerate(rows):
+        out = rp.folder(runs, row, tag, a.scale)
+        print(f"[{k + 1}/{len(rows)}] {row.name}: {row.what} -> {out}", flush=True)
+        try:
+            s = rp.run_row(row, names, out, a.scale, a.dataset, a.width, not a.quiet)
+        except KeyboardInterrupt:
+            interrupted = True
+            print(f"interrupted: {out} resumes where it stopped when this command is run again")
+            break
+        print(f"  induced {s['found']} of {s['concepts']}, {s['exact_on_all_test_pairs']} exact on all test pairs, "
+              f"{s['wall_seconds']:.0f} s")
+    return _write_report(a, runs) or (130 if interrupted else 0)
+
+
+def _write_report(a: argparse.Namespace, runs: Path) -> int:
+    from vcc import report
+
+    st = stamp()
+    rows = report.collect_rows(runs)
+    out = Path(a.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps({**st, "benchmark": "reproduce", "runs": str(runs), "rows": rows}, indent=1))
+    report.write(out.parent, runs, Path(a.report), st, Path(a.others) if a.others else None)
+    print(f"{len(rows)} row runs -> {out}; report -> {a.report}")
+    return 0
+
+
+def cmd_bench_report(a: argparse.Namespace) -> int:
+    return _write_report(a, Path(a.runs))
+
+
+def _report_flags(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--runs", default="benchmarks/reproduce", help="row run folders (default benchmarks/reproduce)")
+    p.add_argument("--out", default="benchmarks/results/reproduce.json",
+                   help="results JSON; the report reads every result JSON beside it")
+    p.add_argument("--report", default="benchmarks/REPORT.md", help="the generated report")
+    p.add_argument("--others", default="benchmarks/induction",
+                   help="committed induction runs to list apart (default benchmarks/induction; '' for none)")
+
+
 def _concept_flags(p: argparse.ArgumentParser, sample: int) -> None:
     p.add_argument("--concepts", help="comma-separated concepts (default: --sample spread over all 546)")
     p.add_argument("--sample", type=int, default=sample, help=f"concepts, evenly spread (default {sample})")
@@ -213,3 +271,21 @@ def add_commands(sub) -> None:
     e.add_argument("--repeats", type=int, default=3, help="timed passes (the best is kept)")
     e.add_argument("--out", default="benchmarks/results/emulator.json", help="result JSON")
     e.set_defaults(fn=cmd_bench_emulator)
+    r = bsub.add_parser("reproduce", help="the paper's induction experiments as rows beside its figures",
+                        description="Run the paper's experiments (budgets, order 0/1, arguments uniform/"
+                                    "predicted/predicted+fixation, the learning curve) as explore-compress "
+                                    "runs, one folder per row under --runs; rerunning resumes. Then write "
+                                    "the results JSON and benchmarks/REPORT.md (rows not run say so).")
+    r.add_argument("--rows", default="all", help="comma-separated rows, 'all' (default) or 'none' (report only)")
+    r.add_argument("--list", action="store_true", help="list the rows and the paper's figures, run nothing")
+    r.add_argument("--concepts", default="all", help="'all' (default), 'demo' or a comma-separated list")
+    r.add_argument("--scale", type=float, default=1.0,
+                   help="multiply every row's budget (a tiny CI run; the folder name says so)")
+    r.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
+    r.add_argument("--width", type=int, default=32, help="concepts searched in lockstep (default 32)")
+    r.add_argument("--quiet", action="store_true", help="no progress bars")
+    _report_flags(r)
+    r.set_defaults(fn=cmd_bench_reproduce)
+    g = bsub.add_parser("report", help="regenerate benchmarks/REPORT.md from the measured results (runs nothing)")
+    _report_flags(g)
+    g.set_defaults(fn=cmd_bench_report)

@@ -1,0 +1,147 @@
+"""`vcc bench reproduce`: the paper's induction experiments as rows, each an explore-
+compress run of our own beside the paper's figure.
+
+Every row is one `search.induce` run in its own folder (resumable: rerun the same
+command and it goes on where it stopped), so long settings run in pieces. Subroutines
+on/off needs no run of its own: a run turns subroutines on only once its plain model
+has saturated, so what it found before that is what the same run with them off finds
+(`found_without_subroutines`). The report reads whatever row folders exist; a row that
+was not run says so.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from collections import Counter
+from collections.abc import Sequence
+from pathlib import Path
+
+from search.induce import Settings
+
+MAIN = "o1-predfix-0.5M"  # the issue's headline run: order 1, predicted + fixation, 0.5M
+
+
+@dataclasses.dataclass(frozen=True)
+class Row:
+    name: str
+    what: str
+    settings: Settings
+    paper: str  # the paper's figure for this setting, in its words ("-" where it gives none)
+    examples: int = 10  # training pairs per concept (the learning curve takes fewer)
+    short_only: bool = False  # the learning curve's concepts (see `concepts_of`)
+
+
+def _rows() -> list[Row]:
+    rows = []
+    for budget, tag, paper in ((250_000, "0.25M", "in a figure only (Fig 4E-H)"),
+                               (500_000, "0.5M", "524 of 546 at 0.4M"),
+                               (1_000_000, "1M", "526 of 546 (525 in the order 0 / order 1 comparison)"),
+                               (3_000_000, "3M", "535 of 546 (the programs listed in Fig 2)")):
+        rows.append(Row(f"o1-predfix-{tag}", f"order 1, subroutines, predicted arguments + fixation, {tag}",
+                        Settings(budget=budget, order=1, args="predicted+fixation"), paper))
+    rows += [
+        Row("o1-predicted-0.5M", "order 1, predicted arguments (no fixation guidance), 0.5M",
+            Settings(budget=500_000, args="predicted"), "148 of 546 at 0.4M without fixation guidance"),
+        Row("o1-uniform-0.5M", "order 1, arguments uniform (no prediction), 0.5M",
+            Settings(budget=500_000, args="uniform"), "150 of 546 without argument prediction (1M)"),
+        Row("o0-predfix-1M", "order 0, subroutines, predicted arguments + fixation, 1M",
+            Settings(budget=1_000_000, order=0, args="predicted+fixation"),
+            "7 new with subroutines, 0 without, at 1M (41 without and 61 more with at 3M)"),
+    ]
+    for k in range(1, 11):  # the learning curve: first-iteration search only, as the paper's
+        rows.append(Row(f"examples-{k}", f"{k} training example{'s' * (k > 1)}, iteration 0 only, "
+                        "order 1, predicted + fixation, 0.5M",
+                        Settings(budget=500_000, args="predicted+fixation", max_iterations=1),
+                        "flattens after 5 examples (Fig 5C)", examples=k, short_only=True))
+    return rows
+
+
+ROWS: tuple[Row, ...] = tuple(_rows())
+BY_NAME = {r.name: r for r in ROWS}
+SHORT = 7  # the learning curve's concepts: reference programs of at most 7 instructions
+
+
+def select(spec: str) -> list[Row]:
+    if spec in ("", "all"):
+        return list(ROWS)
+    if spec == "none":
+        return []
+    names = [s.strip() for s in spec.split(",") if s.strip()]
+    unknown = [n for n in names if n not in BY_NAME]
+    if unknown:
+        raise ValueError(f"unknown row(s): {', '.join(unknown)}; rows are: {', '.join(BY_NAME)}")
+    return [BY_NAME[n] for n in names]
+
+
+def concepts_of(row: Row, chosen: Sequence[str]) -> list[str]:
+    """The learning curve's concepts are the short ones (the paper's are those its first
+    iteration found: a uniform model reaches about this far)."""
+    if not row.short_only:
+        return list(chosen)
+    from vccjax.concepts import reference_program
+
+    return [c for c in chosen if len(reference_program(c)) <= SHORT]
+
+
+def scaled(row: Row, scale: float) -> Settings:
+    return dataclasses.replace(row.settings, budget=max(1, int(round(row.settings.budget * scale))))
+
+
+def folder(runs: Path, row: Row, tag: str, scale: float) -> Path:
+    """A row's run folder; another concept set or budget scale is another folder."""
+    return runs / (row.name + (f"-{tag}" if tag else "") + (f"-x{scale:g}" if scale != 1 else ""))
+
+
+def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset: str | None, width: int,
+            progress: bool) -> dict:
+    from search.explore import Explorer
+    from search.induce import induce, summary
+    from vccjax.dataset import dataset_for
+
+    names = concepts_of(row, concepts)
+    ds = dataset_for(names, 0, dataset, progress=False)
+
+    def pairs(c: str, split: str):
+        got = ds.pairs(c, split)
+        return got[: row.examples] if split == "train" else got
+
+    run = induce(names, pairs, out, scaled(row, scale), explorer=Explorer(width=width), progress=progress,
+                 examples_sha256=lambda c: f"{ds.sha256(c)}:first{row.examples}")
+    s = {**summary(run, names), "row": row.name, "complete": True, "concepts_list": names}
+    (out / "summary.json").write_text(json.dumps(s, indent=1))
+    return s
+
+
+def read_row(path: Path) -> dict | None:
+    """A row folder's figures: its summary when the run finished, else what its records say
+    so far (marked partial). None when the folder holds no run."""
+    from search.induce import Run, summary
+
+    if not (path / "run.json").exists():
+        return None
+    done = path / "summary.json"
+    if done.exists():
+        s = {"complete": True, **json.loads(done.read_text())}  # written when a run ends
+    else:
+        info = json.loads((path / "run.json").read_text())
+        s = {**summary(Run.view(path), sorted(info.get("examples_sha256", {}))), "complete": False}
+    s["lengths_per_iteration"] = lengths(path)
+    return s
+
+
+def lengths(path: Path) -> dict[str, dict[int, int]]:
+    """Programs found in each iteration by length (atomic instructions)."""
+    out: dict[str, Counter] = {}
+    f = path / "results.jsonl"
+    if not f.exists():
+        return {}
+    for line in f.read_text().splitlines():
+        try:
+            r = json.loads(line)
+        except json.JSONDecodeError:
+            continue
+        if r.get("found") and r.get("program"):
+            n = len([s for s in r["program"].replace("\n", ";").split(";") if s.strip()])
+            out.setdefault(str(r["iteration"]), Counter())[n] += 1
+    return {it: dict(sorted(c.items())) for it, c in sorted(out.items(), key=lambda x: int(x[0]))}
