@@ -41,6 +41,17 @@ def run_bits(lo: jax.Array, hi: jax.Array, cfg: VCCConfig) -> jax.Array:
     return low_bits(b) & ~low_bits(a)
 
 
+def fold(op, x: jax.Array, axis: int) -> jax.Array:
+    """Reduce a small static axis by `op` as a chain of elementwise ops: XLA on CPU fuses
+    these into the surrounding loop, where a reduce over an inner axis of a batched
+    array runs many times slower."""
+    parts = [jax.lax.index_in_dim(x, j, axis, keepdims=False) for j in range(x.shape[axis])]
+    out = parts[0]
+    for p in parts[1:]:
+        out = op(out, p)
+    return out
+
+
 def _lines(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int):
     """Per object: its mask lines' raster indices (N, K) and runs (N, K, 2) lo, hi, now.
 
@@ -59,14 +70,19 @@ def occupancy(
     """(R, W) bit lines of every alive object except slot `exclude`, plus the imagined one.
 
     Objects never overlap (scenes are validated, motion and imagination keep it so), so
-    adding disjoint bit words is OR-ing them.
+    adding disjoint bit words is OR-ing them. Each object's K lines are added as one block
+    at its first line (a mask's pixels lie in the raster, so its first line is in [0, R)
+    and lines past the raster are empty): a scatter of N blocks, not of N * K lines.
     """
     lines, lo, hi = _lines(c, s, cfg, axis)
     keep = s.alive & (jnp.arange(cfg.n_max) != exclude)
-    bits = jnp.sum(run_bits(lo, hi, cfg), axis=2, dtype=jnp.uint32)  # (N, K, W)
+    bits = fold(jnp.bitwise_or, run_bits(lo, hi, cfg), 2)  # (N, K, W)
     bits = jnp.where(keep[:, None, None], bits, jnp.uint32(0))
-    occ = jnp.zeros((cfg.raster, cfg.words), jnp.uint32)
-    occ = occ.at[jnp.clip(lines, 0, cfg.raster - 1)].add(bits)
+    blocks = jax.lax.ScatterDimensionNumbers(
+        update_window_dims=(1, 2), inserted_window_dims=(), scatter_dims_to_operand_dims=(0,)
+    )
+    occ = jnp.zeros((cfg.raster + cfg.mask_rows, cfg.words), jnp.uint32)
+    occ = jax.lax.scatter_add(occ, lines[:, :1], bits, blocks)[: cfg.raster]
     if imagined:
         im = imagined_runs(s.imag_kind, s.imag_pos, cfg)[axis]
         occ = occ | run_bits(im[:, 0], im[:, 1], cfg)
@@ -171,7 +187,9 @@ def carry_toward(c: SceneConst, s: VCCState, cfg: VCCConfig, target: jax.Array) 
 
     The held object's mask is made once as bit words at its current place; at each sample
     it is shifted as a whole (words moved by d // 32, bits by d % 32) and tested against
-    the K occupancy lines under it, read as one slice of the padded bitmap."""
+    the K occupancy lines under it, read as one slice of the padded bitmap. The test ORs
+    the words, then the lines, by `fold` (in that order): under vmap on CPU, a reduce
+    there was most of the carry's time."""
     i = s.held
     k, w = cfg.mask_rows, cfg.words
     path = toward_path(c.base[i] + s.offset[i] * cfg.sub, target, cfg)  # (P, 2)
@@ -191,7 +209,7 @@ def carry_toward(c: SceneConst, s: VCCState, cfg: VCCConfig, target: jax.Array) 
         below = jax.lax.dynamic_slice(wide, (0, w - q), (k, w))
         moved = jnp.left_shift(here, b) | jnp.right_shift(below, jnp.uint32(32) - b)  # >> 32 is 0
         under = jax.lax.dynamic_slice(occ, (lines[i, 0] + d[1] + k, 0), (k, w))
-        return jnp.any((moved & under) != 0)
+        return fold(jnp.bitwise_or, fold(jnp.bitwise_or, moved & under, 1), 0) != 0
 
     bad = out | jax.vmap(hits)(path)
     first_bad = jnp.where(bad.any(), jnp.argmax(bad), path.shape[0])
