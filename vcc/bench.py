@@ -190,7 +190,7 @@ def cmd_bench_reproduce(a: argparse.Namespace) -> int:
     if a.scale <= 0:
         raise ValueError(f"--scale must be positive, got {a.scale}")
     names = concept_list(a.concepts)
-    tag = "" if a.concepts == "all" else ("demo" if a.concepts == "demo" else f"{len(names)}concepts")
+    tag = rp.concept_tag(a.concepts, names)
     runs = Path(a.runs)
     if rows:
         enable_compile_cache()

@@ -73,7 +73,7 @@ def search_section(results: list[tuple[str, dict]]) -> list[str]:
     return lines
 
 
-def _cell(s: dict | None, total: int | None = None) -> str:
+def _cell(s: dict | None) -> str:
     if s is None:
         return "not run"
     part = "" if s.get("complete") else " (partial: run interrupted, resumable)"
@@ -183,8 +183,6 @@ def collect_rows(runs: Path) -> dict[str, dict]:
         for path in sorted(p for p in runs.iterdir() if p.is_dir()):
             s = rp.read_row(path)
             if s is not None:
-                s.setdefault("row", next((r.name for r in sorted(rp.ROWS, key=lambda r: -len(r.name))
-                                          if path.name.startswith(r.name)), path.name))
                 out[path.name] = s
     return out
 

@@ -12,6 +12,7 @@ was not run says so.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 from collections import Counter
 from collections.abc import Sequence
@@ -108,7 +109,7 @@ def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset:
 
     run = induce(names, pairs, out, scaled(row, scale), explorer=Explorer(width=width), progress=progress,
                  examples_sha256=lambda c: f"{ds.sha256(c)}:first{row.examples}")
-    s = {**summary(run, names), "row": row.name, "complete": True, "concepts_list": names}
+    s = {**summary(run, names), "complete": True, "concepts_list": names}
     (out / "summary.json").write_text(json.dumps(s, indent=1))
     return s
 
@@ -120,27 +121,35 @@ def read_row(path: Path) -> dict | None:
 
     if not (path / "run.json").exists():
         return None
+    run = Run.view(path)
     done = path / "summary.json"
     if done.exists():
         s = {"complete": True, **json.loads(done.read_text())}  # written when a run ends
     else:
-        info = json.loads((path / "run.json").read_text())
-        s = {**summary(Run.view(path), sorted(info.get("examples_sha256", {}))), "complete": False}
-    s["lengths_per_iteration"] = lengths(path)
-    return s
+        names = sorted(json.loads((path / "run.json").read_text()).get("examples_sha256", {}))
+        s = {**summary(run, names), "complete": False}
+    return {**s, "row": row_of(path.name), "lengths_per_iteration": lengths(run.records)}
 
 
-def lengths(path: Path) -> dict[str, dict[int, int]]:
+def row_of(folder_name: str) -> str:
+    """The row a run folder holds (its name starts with the row's; the longest match wins)."""
+    return next((r for r in sorted(BY_NAME, key=len, reverse=True) if folder_name.startswith(r)), folder_name)
+
+
+def concept_tag(spec: str, names: Sequence[str]) -> str:
+    """A folder suffix naming the concept set: none for all 546; two lists of the same
+    length get different suffixes, so their runs never mix."""
+    if spec == "all":
+        return ""
+    if spec == "demo":
+        return "demo"
+    return f"{len(names)}concepts-{hashlib.sha256(','.join(sorted(names)).encode()).hexdigest()[:6]}"
+
+
+def lengths(records: Sequence[dict]) -> dict[str, dict[int, int]]:
     """Programs found in each iteration by length (atomic instructions)."""
     out: dict[str, Counter] = {}
-    f = path / "results.jsonl"
-    if not f.exists():
-        return {}
-    for line in f.read_text().splitlines():
-        try:
-            r = json.loads(line)
-        except json.JSONDecodeError:
-            continue
+    for r in records:
         if r.get("found") and r.get("program"):
             n = len([s for s in r["program"].replace("\n", ";").split(";") if s.strip()])
             out.setdefault(str(r["iteration"]), Counter())[n] += 1
