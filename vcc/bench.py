@@ -218,7 +218,7 @@ def _write_report(a: argparse.Namespace, runs: Path) -> int:
     out = Path(a.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps({**st, "benchmark": "reproduce", "runs": str(runs), "rows": rows}, indent=1))
-    report.write(out.parent, runs, Path(a.report), st, Path(a.others) if a.others else None)
+    report.write(out.parent, rows, Path(a.report), st, Path(a.others) if a.others else None)
     print(f"{len(rows)} row runs -> {out}; report -> {a.report}")
     return 0
 

@@ -187,9 +187,9 @@ def collect_rows(runs: Path) -> dict[str, dict]:
     return out
 
 
-def write(results_dir: Path, runs: Path, out: Path, stamp: dict, others: Path | None = None) -> str:
+def write(results_dir: Path, rows: dict[str, dict], out: Path, stamp: dict, others: Path | None = None) -> str:
+    """`rows`: what `collect_rows` read (the caller writes them to the results JSON too)."""
     results = _load(results_dir)
-    rows = collect_rows(runs)
     lines = ["# vccjax benchmark report", "",
              f"Generated {stamp['date']} at commit {stamp['commit']} by `{stamp['command']}` on "
              f"{stamp['machine']['cores']} cores ({stamp['machine']['cpu']}), JAX {stamp['machine']['jax']}. "
