@@ -12,11 +12,12 @@ DEFAULT_DATA = Path.home() / ".cache" / "vccjax" / "argpred-data"
 def cmd_data(a: argparse.Namespace) -> int:
     import os
 
-    from argpred.data import build
+    from argpred.data import build, built
 
+    joined = 0.0 if a.kind == "carry" else a.joined
     m = build(a.out, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet,
-              joined=a.joined)
-    print(f"{len(m['shards'])} shards ({len(m['shards']) * m['shard']} programs) in {a.out}")
+              joined=joined, kind=a.kind)
+    print(f"{len(m['shards'])} shards ({built(a.out)['programs']} {a.kind} programs) in {a.out}")
     return 0
 
 
@@ -27,7 +28,7 @@ def cmd_train(a: argparse.Namespace) -> int:
     import numpy as np
 
     from argpred import data as argdata
-    from argpred.train import TrainSettings, train
+    from argpred.train import TrainSettings, train_members
     from argpred.weights import save
 
     start = time.time()
@@ -47,16 +48,27 @@ def cmd_train(a: argparse.Namespace) -> int:
         argdata.build(folder, programs, seed=have["seed"] if have else a.seed,
                       workers=a.workers or os.cpu_count() or 1, progress=not a.quiet, joined=joined)
         data = argdata.load(folder)
-    settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, depth=a.depth, epochs=a.epochs, batch=a.batch,
-                             learning_rate=a.lr, l1=a.l1, positive_weight=a.positive_weight, seed=a.seed)
+    if a.carry and not any((argdata.built(f) or {}).get("kind") == "carry" for f in folders):
+        carry = DEFAULT_DATA / f"seed{a.seed}-carry{a.carry}"  # the carry programs (argpred.data.carry_program)
+        argdata.build(carry, a.carry, seed=a.seed, progress=not a.quiet, kind="carry")
+        more = argdata.load(carry)
+        data = {k: np.concatenate([data[k], more[k]]) for k in data}
+    settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, depth=a.depth, evidence=a.evidence,
+                             bias_start=a.bias_start, epochs=a.epochs, batch=a.batch, learning_rate=a.lr, l1=a.l1,
+                             positive_weight=a.positive_weight, seed=a.seed)
     out = Path(a.out)
-    model, params, history = train(data, settings, checkpoint=out.with_suffix(".ckpt"), progress=not a.quiet)
+    model, params, histories = train_members(data, settings, a.members, checkpoint=out.with_suffix(".ckpt"),
+                                             workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
     sha = save(out, model, params, {"settings": {k: getattr(settings, k) for k in settings.__dataclass_fields__},
-                                    "programs": int(len(data["labels"])), "history": history})
-    last = history[-1]
-    print(f"trained on {len(data['labels'])} programs in {time.time() - start:.0f}s: "
-          f"train bce {last['train_bce']:.4f}, held-out bce {last.get('val_bce', float('nan')):.4f}, "
-          f"held-out programs with every label right {last.get('val_all_labels_right', float('nan')):.3f}")
+                                    "programs": int(len(data["labels"])),
+                                    "history": histories[0] if a.members == 1 else histories})
+    for k, history in enumerate(histories):
+        last = history[-1]
+        who = f"member {k} (seed {a.seed + k}) " if a.members > 1 else ""
+        print(f"{who}trained on {len(data['labels'])} programs: "
+              f"train bce {last['train_bce']:.4f}, held-out bce {last.get('val_bce', float('nan')):.4f}, "
+              f"held-out programs with every label right {last.get('val_all_labels_right', float('nan')):.3f}")
+    print(f"{a.members} member(s) in {time.time() - start:.0f}s")
     print(f"weights: {out} (sha256 {sha})")
     return 0
 
@@ -91,6 +103,9 @@ def add_commands(sub) -> None:
     d.add_argument("--joined", type=float, default=0.3,
                    help="share of programs drawn as two parts joined by reset_attn (default 0.3, as the "
                         "shipped weights)")
+    d.add_argument("--kind", choices=("drawn", "carry"), default="drawn",
+                   help="drawn (default): programs of 3 to 6 instructions; carry: an object carried onto "
+                        "another one (what `train --carry` adds)")
     d.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")
     d.add_argument("--quiet", action="store_true")
     d.set_defaults(fn=cmd_data)
@@ -116,6 +131,15 @@ def add_commands(sub) -> None:
                    help="share of two-part programs in newly drawn data (default: the folder's, else 0.3)")
     t.add_argument("--kernel", type=int, default=3)
     t.add_argument("--depth", type=int, default=1, help="hidden convolutions (with --hidden > 0)")
+    t.add_argument("--evidence", choices=("signed", "relu"), default="relu",
+                   help="relu (default): an example adds evidence for an argument or nothing; signed: the "
+                        "paper's plain sum, where examples that do not show an argument count against it")
+    t.add_argument("--bias-start", type=float, default=-4.0, help="first bias of every label under --evidence relu")
+    t.add_argument("--carry", type=int, default=30,
+                   help="carry programs (an object carried onto another one: 10 instructions, beyond the drawn "
+                        "six) added to the data, drawn into DEFAULT/seedS-carryN (default 30; 0: none)")
+    t.add_argument("--members", type=int, default=3,
+                   help="networks trained from seeds S, S+1, ... whose probabilities are averaged (default 3)")
     t.add_argument("--seed", type=int, default=0)
     t.add_argument("--workers", type=int, default=0, help="processes for the data (default: one per core)")
     t.add_argument("--quiet", action="store_true")

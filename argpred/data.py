@@ -18,6 +18,13 @@ most of them thrown away by the filters, so we draw programs and apply the filte
   one at a time (outputs unchanged) until every one left is indispensable.
 No concept of the 546 is used. Programs are drawn in shards, each seeded by (seed,
 shard), and written as they finish, so a build resumes and gives the same bytes.
+
+A second kind of folder (`kind="carry"`) holds programs no draw of six instructions
+reaches: carry one selected object onto another one (two attends, 10 instructions),
+the elementary "put A at B". Its selectors are drawn (a shape or colour filter, a
+fixation, the pointer or none; the target by a filter), then the same filters apply.
+Without them the predictor never sees a filter whose object stays where it is
+(docs/argpred.md).
 """
 
 from __future__ import annotations
@@ -43,6 +50,7 @@ PREDICTED: tuple[str, ...] = ("set_shape_attn", "set_color_attn", "fill_color")
 LABELS: tuple[tuple[str, str], ...] = tuple((f, v) for f in PREDICTED for v in arg_domain(f))
 FORMAT, VERSION = "vccjax-argpred-data", 1
 SHARD = 100  # programs per shard file
+KINDS = ("drawn", "carry")
 LENGTHS = (3, 6)  # scene_parse and one instruction change no scene; 6 as the paper (8: docs/argpred.md)
 _DRAWABLE = tuple(op for op in range(len(NAMES)) if op != OP["scene_parse"])
 
@@ -178,16 +186,56 @@ def kept_program(rng: np.random.Generator, pool: dict[bool, list[Scene]], probes
             return program, pairs
 
 
-def build_shard(seed: int, shard: int, size: int = SHARD, joined: float = 0.0) -> dict[str, np.ndarray]:
+def _selector(rng: np.random.Generator, filters_only: bool = False) -> list[tuple[str, str | None]]:
+    """How a carry picks an object: a shape or colour filter, a fixation, the pointer, or
+    none (the first attended object)."""
+    k = int(rng.integers(2 if filters_only else 5))
+    if k < 2:
+        f = PREDICTED[k]
+        return [(f, arg_domain(f)[int(rng.integers(len(arg_domain(f))))])]
+    if k == 2:
+        return [("fixate", arg_domain("fixate")[int(rng.integers(len(arg_domain("fixate"))))])]
+    return [("fixate_pointer", None)] if k == 3 else []
+
+
+def carry_program(rng: np.random.Generator, fill: float = 0.25) -> Program:
+    """Pick an object, carry it onto another one picked by a filter, release it (and,
+    `fill` of the time, recolour what is attended then)."""
+    steps = [("scene_parse", None), *_selector(rng), ("top_down_attend", None),
+             ("move_hand_to_attended_object", None), ("grab_object", None), ("reset_attn", None),
+             *_selector(rng, filters_only=True), ("top_down_attend", None),
+             ("move_hand_to_attended_object", None), ("release_object", None)]
+    if rng.random() < fill:
+        steps.append(("fill_color", arg_domain("fill_color")[int(rng.integers(len(arg_domain("fill_color"))))]))
+    return Program(tuple(OP[n] for n, _ in steps), tuple(0 if a is None else arg_domain(n).index(a) for n, a in steps))
+
+
+def kept_carry(rng: np.random.Generator, max_tries: int = 60) -> tuple[Program, list[tuple[Scene, Scene]]]:
+    """A carry program whose 10 examples can be drawn, made minimal (as `kept_program`)."""
+    while True:
+        program = carry_program(rng)
+        try:
+            pairs = make_pairs(program, TRAIN, rng, jitter=None, max_tries=max_tries)
+        except ExampleError:
+            continue
+        return minimal(program, pairs), pairs
+
+
+def build_shard(seed: int, shard: int, size: int = SHARD, joined: float = 0.0,
+                kind: str = "drawn") -> dict[str, np.ndarray]:
     """`joined`: the share of programs drawn as two parts joined by reset_attn (0 keeps
-    the draws of the shipped weights' data byte for byte)."""
-    key = [seed, shard, 0xA59] + ([int(round(joined * 1000))] if joined else [])
+    the draws of the shipped weights' data byte for byte); `kind="carry"`: carry
+    programs (`carry_program`) instead."""
+    if kind == "carry":
+        key = [seed, shard, 0xCA77]
+    else:
+        key = [seed, shard, 0xA59] + ([int(round(joined * 1000))] if joined else [])
     rng = np.random.default_rng(key)
     progs, ins, outs = [], [], []
     seen: set = set()
-    pool = scene_pool(rng)
+    pool = scene_pool(rng) if kind == "drawn" else {}
     while len(progs) < size:
-        program, pairs = kept_program(rng, pool, joined=joined)
+        program, pairs = kept_program(rng, pool, joined=joined) if kind == "drawn" else kept_carry(rng)
         if (program.ops, program.args) in seen:
             continue
         seen.add((program.ops, program.args))
@@ -201,6 +249,7 @@ def build_shard(seed: int, shard: int, size: int = SHARD, joined: float = 0.0) -
         "inputs": np.stack(ins), "outputs": np.stack(outs),  # (P, 10, 9, 4) int8 cells
         "labels": np.stack([labels_of(p) for p in progs]),
         **({"joined": np.array([joined])} if joined else {}),
+        **({"kind": np.frombuffer(kind.encode(), np.uint8)} if kind != "drawn" else {}),
     }
 
 
@@ -209,71 +258,83 @@ def _sha(path: Path) -> str:
 
 
 def build(out: str | Path, programs: int, seed: int = 0, workers: int = 1,
-          progress: bool = True, joined: float = 0.0) -> dict:
-    """Build (or resume) `programs` training programs (rounded up to shards) under `out`.
-    A folder built with another seed or share of joined programs is refused, not rebuilt."""
+          progress: bool = True, joined: float = 0.0, kind: str = "drawn") -> dict:
+    """Build (or resume) `programs` training programs of `kind` under `out`, in shards of
+    100 (the last one holds the rest). A folder built with another seed, kind or share
+    of joined programs is refused, not rebuilt."""
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     from tqdm import tqdm
 
+    if kind not in KINDS:
+        raise ValueError(f"unknown kind of training data {kind!r} (one of {', '.join(KINDS)})")
+    if kind == "carry" and joined:
+        raise ValueError("carry programs are not joined; use joined=0 for kind 'carry'")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     n = -(-programs // SHARD)
+    sizes = [min(SHARD, programs - k * SHARD) for k in range(n)]
     if (out / "manifest.json").exists():
         try:
             old = json.loads((out / "manifest.json").read_text())
-            mine = (old["seed"], old.get("joined", 0.0))
+            mine = (old["seed"], old.get("joined", 0.0), old.get("kind", "drawn"))
         except (ValueError, KeyError, TypeError) as e:
             raise DataFileError(f"{out / 'manifest.json'}: not a manifest of this data ({e})") from None
-        if mine != (seed, joined):
-            raise DataFileError(f"{out}: built with seed {mine[0]} and joined {mine[1]}, asked for seed {seed} "
-                                f"and joined {joined}; use those or another folder")
-    todo = [k for k in range(n) if not _valid_shard(out / f"shard{k:04d}.npz", seed, k, joined)]
-    bar = tqdm(total=n, initial=n - len(todo), desc="argpred data", unit="shard", disable=not progress)
+        if mine != (seed, joined, kind):
+            raise DataFileError(f"{out}: built with seed {mine[0]}, joined {mine[1]}, kind {mine[2]}; asked for seed "
+                                f"{seed}, joined {joined}, kind {kind}; use those or another folder")
+    jobs = [(out, seed, k, joined, kind, sizes[k]) for k in range(n)]
+    todo = [j for j in jobs if not _valid_shard(*j)]
+    bar = tqdm(total=n, initial=n - len(todo), desc=f"argpred data ({kind})", unit="shard", disable=not progress)
     if workers > 1 and len(todo) > 1:
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-            for _ in pool.map(_write_shard, [(out, seed, k, joined) for k in todo]):
+            for _ in pool.map(_write_shard, todo):
                 bar.update()
     else:
-        for k in todo:
-            _write_shard((out, seed, k, joined))
+        for job in todo:
+            _write_shard(job)
             bar.update()
     bar.close()
     manifest = {"format": FORMAT, "version": VERSION, "seed": seed, "joined": joined, "shard": SHARD,
                 "lengths": list(LENGTHS),
                 "labels": [list(x) for x in LABELS], "max_objects": MAX_OBJECTS,
-                "shards": {f"shard{k:04d}.npz": _sha(out / f"shard{k:04d}.npz") for k in range(n)}}
+                "shards": {f"shard{k:04d}.npz": _sha(out / f"shard{k:04d}.npz") for k in range(n)},
+                **({"kind": kind, "programs": programs} if kind != "drawn" else {})}
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
     return manifest
 
 
 def built(folder: str | Path) -> dict | None:
-    """What a built folder's manifest says: programs, seed and joined share (None when
-    there is none), so that training on an existing folder keeps all of it as it is."""
+    """What a built folder's manifest says: programs, seed, joined share and kind (None
+    when there is none), so that training on an existing folder keeps all of it as it is."""
     try:
         manifest = json.loads((Path(folder) / "manifest.json").read_text())
-        return {"programs": len(manifest["shards"]) * int(manifest["shard"]), "seed": int(manifest["seed"]),
-                "joined": float(manifest.get("joined", 0.0))}
+        return {"programs": int(manifest.get("programs", len(manifest["shards"]) * int(manifest["shard"]))),
+                "seed": int(manifest["seed"]), "joined": float(manifest.get("joined", 0.0)),
+                "kind": str(manifest.get("kind", "drawn"))}
     except (OSError, ValueError, KeyError, TypeError):
         return None
 
 
 def _write_shard(job) -> None:
-    out, seed, k, joined = job
-    arrays = build_shard(seed, k, joined=joined)
+    out, seed, k, joined, kind, size = job
+    arrays = build_shard(seed, k, size=size, joined=joined, kind=kind)
     tmp = out / f"shard{k:04d}.tmp.npz"
     np.savez_compressed(tmp, **arrays)
     tmp.replace(out / f"shard{k:04d}.npz")  # whole or not at all
 
 
-def _valid_shard(path: Path, seed: int, k: int, joined: float = 0.0) -> bool:
+def _valid_shard(out: Path, seed: int, k: int, joined: float = 0.0, kind: str = "drawn", size: int = SHARD) -> bool:
+    path = out / f"shard{k:04d}.npz"
     if not path.exists():
         return False
     try:
         with np.load(path, allow_pickle=False) as z:
             share = float(z["joined"][0]) if "joined" in z.files else 0.0
-            return int(z["format_version"][0]) == VERSION and z["seed"].tolist() == [seed, k] and share == joined
+            made = bytes(z["kind"]).decode() if "kind" in z.files else "drawn"
+            return (int(z["format_version"][0]) == VERSION and z["seed"].tolist() == [seed, k] and share == joined
+                    and made == kind and len(z["labels"]) == size)
     except (OSError, ValueError, KeyError):
         return False  # cut or foreign: rebuild it
 

@@ -7,6 +7,13 @@ vote: an argument several examples show is more certain.
 puts `depth` ReLU convolutions of that many channels before it (see `docs/argpred.md`
 for what each gives). Two layers see 5x5 cells: an object and the cell a moved one
 lands on beside it.
+
+`evidence="relu"` keeps each example's pooled logit at or above zero before the sum:
+an example that does not show an argument then says nothing against it. Under
+"signed" (the paper's sum) the examples of an "A and B" concept that hold no object
+of B's colour outvote the ones that show B, and B's filter is lost. The bias starts
+at `bias_start`, since the sum of ten non-negative terms would start every label
+near probability one.
 """
 
 from __future__ import annotations
@@ -22,6 +29,8 @@ class ArgNet(nn.Module):
     hidden: int = 32
     kernel: int = 3
     depth: int = 1  # hidden convolutions (when hidden > 0)
+    evidence: str = "signed"  # "relu": an example adds evidence for a label or nothing (see below)
+    bias_start: float = -4.0  # the bias's first value under "relu" (zero under "signed")
 
     @nn.compact
     def __call__(self, x: jax.Array, mask: jax.Array) -> jax.Array:
@@ -35,5 +44,10 @@ class ArgNet(nn.Module):
         else:
             h = nn.Conv(len(LABELS), (self.kernel, self.kernel), use_bias=False, name="conv_out")(h)
         pooled = h.max(axis=(-3, -2))  # (B, E, labels)
-        bias = self.param("bias", nn.initializers.zeros, (len(LABELS),))
+        if self.evidence == "relu":
+            pooled = nn.relu(pooled)
+        elif self.evidence != "signed":
+            raise ValueError(f"unknown evidence {self.evidence!r} (signed or relu)")
+        start = 0.0 if self.evidence == "signed" else self.bias_start
+        bias = self.param("bias", nn.initializers.constant(start), (len(LABELS),))
         return (pooled * mask[..., None]).sum(axis=1) + bias

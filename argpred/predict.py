@@ -14,7 +14,7 @@ import numpy as np
 
 from argpred.data import LABELS, PREDICTED
 from argpred.features import pair_features
-from argpred.weights import load
+from argpred.weights import load, members_of
 from vccjax.instructions import arg_domain
 from vccjax.scene import Scene
 
@@ -24,7 +24,14 @@ THRESHOLD = 0.55
 class Predictor:
     def __init__(self, weights: str | Path | None = None):
         self.model, self.params, self.card = load(weights)
-        self._apply = jax.jit(lambda p, x, m: jax.nn.sigmoid(self.model.apply({"params": p}, x, m)))
+
+        def one(p, x, m):
+            return jax.nn.sigmoid(self.model.apply({"params": p}, x, m))
+
+        if members_of(self.params) > 1:  # an ensemble: the members' mean probability
+            self._apply = jax.jit(lambda p, x, m: jax.vmap(one, in_axes=(0, None, None))(p, x, m).mean(axis=0))
+        else:
+            self._apply = jax.jit(one)
 
     def probabilities(self, features: np.ndarray) -> np.ndarray:
         """(B, E, 21, 15, 15) features -> (B, labels) probabilities."""

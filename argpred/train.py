@@ -31,6 +31,8 @@ class TrainSettings:
     hidden: int = 32
     kernel: int = 3
     depth: int = 1
+    evidence: str = "relu"  # or "signed", the paper's plain sum (argpred.model)
+    bias_start: float = -4.0
     epochs: int = 30
     batch: int = 64
     learning_rate: float = 3e-3
@@ -51,11 +53,11 @@ def _step(model: ArgNet, tx: optax.GradientTransformation, l1: float, pos: float
         logits = model.apply({"params": p}, x, jnp.ones(x.shape[:2]))
         bce = optax.sigmoid_binary_cross_entropy(logits, y)
         weighted = (bce * jnp.where(y > 0.5, pos, 1.0)).mean()
-        return weighted + l1 * _l1(p), bce.mean()
+        return weighted + l1 * _l1(p), (bce.mean(), weighted)
 
-    (_, bce), grads = jax.value_and_grad(loss_fn, has_aux=True)(params)
+    (_, (bce, weighted)), grads = jax.value_and_grad(loss_fn, has_aux=True)(params)
     updates, opt_state = tx.update(grads, opt_state, params)
-    return optax.apply_updates(params, updates), opt_state, bce
+    return optax.apply_updates(params, updates), opt_state, bce, weighted
 
 
 @functools.partial(jax.jit, static_argnums=0)
@@ -81,7 +83,8 @@ def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = N
     """Train on `data` (argpred.data.load); returns (model, params, per-epoch history)."""
     from tqdm import tqdm
 
-    model = ArgNet(hidden=settings.hidden, kernel=settings.kernel, depth=settings.depth)
+    model = ArgNet(hidden=settings.hidden, kernel=settings.kernel, depth=settings.depth, evidence=settings.evidence,
+                   bias_start=settings.bias_start)
     tx = optax.adam(settings.learning_rate)
     params = init_params(model, settings.seed)
     opt_state = tx.init(params)
@@ -106,12 +109,16 @@ def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = N
     bar = tqdm(range(start, settings.epochs), desc="argpred train", unit="epoch", disable=not progress)
     for epoch in bar:
         order = tr[np.random.default_rng([settings.seed, 2, epoch]).permutation(len(tr))]
-        losses = []
+        losses, objective = [], []
         for x, y in batches(data, order, settings.batch):
-            params, opt_state, bce = _step(model, tx, settings.l1, settings.positive_weight, params, opt_state, jnp.asarray(x), jnp.asarray(y))
+            params, opt_state, bce, weighted = _step(model, tx, settings.l1, settings.positive_weight,
+                                                     params, opt_state, jnp.asarray(x), jnp.asarray(y))
             losses.append(float(bce))
+            objective.append(float(weighted))
         val = evaluate(model, params, data, va, settings.batch) if len(va) else {}
-        history.append({"epoch": epoch + 1, "train_bce": float(np.mean(losses)), **val})
+        # train_loss: what Adam lowers (used labels weighted); train_bce: the plain mean
+        history.append({"epoch": epoch + 1, "train_loss": float(np.mean(objective)),
+                        "train_bce": float(np.mean(losses)), **val})
         bar.set_postfix(train=f"{history[-1]['train_bce']:.4f}", val=f"{val.get('val_bce', float('nan')):.4f}")
         if ckpt:
             ckpt.parent.mkdir(parents=True, exist_ok=True)
@@ -122,6 +129,43 @@ def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = N
                 "data": data_fingerprint(data)}))
             tmp.replace(ckpt)
     return model, params, history
+
+
+def train_members(data: dict, settings: TrainSettings, members: int, checkpoint: str | Path | None = None,
+                  workers: int = 1, progress: bool = True) -> tuple[ArgNet, dict, list[list[dict]]]:
+    """An ensemble: `members` networks trained alike from seeds seed, seed+1, ...
+    (`workers` at a time, each in its own process and checkpoint, so an interrupted
+    run resumes every member); returns (model, stacked params, each member's history).
+    One member is plain `train`."""
+    from argpred.weights import stack
+
+    if members < 1:
+        raise ValueError(f"an ensemble of {members} members")
+    if members == 1:
+        model, params, history = train(data, settings, checkpoint, progress)
+        return model, params, [history]
+    ckpt = Path(checkpoint) if checkpoint else None
+    jobs = [(data, dataclasses.replace(settings, seed=settings.seed + k),
+             ckpt.with_suffix(f".m{k}.ckpt") if ckpt else None) for k in range(members)]
+    if workers > 1:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        from tqdm import tqdm
+
+        with ProcessPoolExecutor(min(workers, members), mp_context=multiprocessing.get_context("spawn")) as pool:
+            done = list(tqdm(pool.map(_member, jobs), total=members, desc="argpred members", disable=not progress))
+    else:
+        done = [_member(job, progress) for job in jobs]
+    model = ArgNet(hidden=settings.hidden, kernel=settings.kernel, depth=settings.depth, evidence=settings.evidence,
+                   bias_start=settings.bias_start)
+    return model, stack([p for p, _ in done]), [h for _, h in done]
+
+
+def _member(job, progress: bool = False):
+    data, settings, ckpt = job
+    _, params, history = train(data, settings, ckpt, progress=progress, log=lambda s: None)
+    return jax.device_get(params), history
 
 
 def data_fingerprint(data: dict) -> str:

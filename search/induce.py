@@ -175,6 +175,22 @@ class Run:
             known.update(hashes)
             self._write_meta(info)
 
+    def check_predictor(self, sha256: str) -> None:
+        """Record the argument predictor's weights (sha256); refuse a resume under other
+        weights, or of records whose weights were not recorded (they would mix)."""
+        meta = self.out / "run.json"
+        info = json.loads(meta.read_text())
+        known = info.get("predictor_sha256")
+        if known is None and self.records:
+            raise DataFileError(f"{meta}: this run's records do not say which argument-predictor weights made "
+                                "them; use another --out to run with these")
+        if known is not None and known != sha256:
+            raise DataFileError(f"{meta}: this run used other argument-predictor weights (sha256 {known[:12]}..., "
+                                f"these are {sha256[:12]}...); use another --out, or those weights")
+        if known is None:
+            info["predictor_sha256"] = sha256
+            self._write_meta(info)
+
     def _write_meta(self, info: dict) -> None:
         tmp = self.out / "run.json.tmp"
         tmp.write_text(json.dumps(info, indent=1))
@@ -235,6 +251,10 @@ def induce(
     run = Run(out, settings)
     if examples_sha256 is not None:
         run.check_examples({c: examples_sha256(c) for c in concepts})
+    if settings.args.startswith("predicted"):
+        from argpred.predict import default_predictor
+
+        run.check_predictor(default_predictor().card["sha256"])
     explorer = explorer or Explorer()
     subs_on = False
     for it in range(settings.max_iterations):

@@ -12,7 +12,8 @@ from argpred import data as argdata
 from argpred.features import CHANNEL_NAMES, CHANNELS, GRID, pair_features
 from argpred.predict import THRESHOLD, Predictor, argument_logp
 from argpred.train import TrainSettings, train
-from argpred.weights import load, save
+from argpred.model import ArgNet
+from argpred.weights import init_params, load, save
 from vccjax.errors import DataFileError
 from vccjax.program import parse
 from vccjax.scene import Scene, SceneObject
@@ -79,9 +80,10 @@ def test_shards_are_seeded_and_data_loads_verified(tiny):
     d = argdata.load(tiny)
     assert d["inputs"].shape == (24, 10, 9, 4) and d["labels"].shape == (24, len(argdata.LABELS))
     assert len(d["programs"]) == 24
-    assert argdata.built(tiny) == {"programs": 24, "seed": 5, "joined": 0.0}  # `train --data` keeps them all
+    # `train --data` keeps them all
+    assert argdata.built(tiny) == {"programs": 24, "seed": 5, "joined": 0.0, "kind": "drawn"}
     assert argdata.built(tiny / "none") is None
-    with pytest.raises(DataFileError, match="built with seed 5 and joined 0"):
+    with pytest.raises(DataFileError, match="built with seed 5, joined 0.0, kind drawn"):
         argdata.build(tiny, 24, seed=6)  # refused, not rebuilt: nothing drawn is lost
     (tiny / "extra").mkdir(exist_ok=True)
     bad = tiny / "extra"
@@ -94,7 +96,7 @@ def test_loss_falls_and_training_resumes_to_the_same_weights(tiny, tmp_path):
     d = argdata.load(tiny)
     settings = TrainSettings(hidden=8, epochs=6, batch=8, learning_rate=1e-2, validation=0.25)
     _, params, hist = train(d, settings, progress=False, log=lambda s: None)
-    assert hist[-1]["train_bce"] < 0.7 * hist[0]["train_bce"]
+    assert hist[-1]["train_loss"] < 0.7 * hist[0]["train_loss"]  # the objective Adam lowers (used labels weighted)
     # interrupted after 3 epochs, resumed from the checkpoint: the same weights
     ckpt = tmp_path / "w.ckpt"
     train(d, TrainSettings(**{**settings.__dict__, "epochs": 3}), checkpoint=ckpt, progress=False)
@@ -122,7 +124,7 @@ def test_weights_round_trip_and_refuse_corrupt_or_foreign_files(tiny, tmp_path):
     probs = p.probabilities(x[None])
     assert probs.shape == (1, len(argdata.LABELS)) and ((probs >= 0) & (probs <= 1)).all()
     m2, params2, card = load(path)
-    assert card["model"] == {"hidden": 4, "kernel": 3, "depth": 1}
+    assert card["model"] == {"hidden": 4, "kernel": 3, "depth": 1, "evidence": "relu", "members": 1}
     data = bytearray(path.read_bytes())
     data[len(data) // 2] ^= 0xFF
     path.write_bytes(bytes(data))
@@ -135,6 +137,82 @@ def test_weights_round_trip_and_refuse_corrupt_or_foreign_files(tiny, tmp_path):
         load(path)
     with pytest.raises(DataFileError, match="missing"):
         load(tmp_path / "none.msgpack")
+
+
+def test_carry_programs_are_seeded_two_attend_procedures_in_their_own_folder(tmp_path):
+    folder = tmp_path / "carry"
+    argdata.build(folder, 5, seed=2, progress=False, kind="carry")
+    assert argdata.built(folder) == {"programs": 5, "seed": 2, "joined": 0.0, "kind": "carry"}
+    d = argdata.load(folder)
+    assert d["inputs"].shape == (5, 10, 9, 4) and len(d["programs"]) == 5
+    for text in d["programs"]:  # pick, grab, then attend a second object and carry the first onto it
+        steps = text.split("; ")
+        assert steps.count("top_down_attend") == 2 and steps.count("grab_object") == 1
+        assert steps.index("grab_object") < len(steps) - 1 - steps[::-1].index("top_down_attend")
+    again = argdata.build_shard(2, 0, size=5, kind="carry")
+    with np.load(folder / "shard0000.npz") as z:
+        assert all(np.array_equal(z[k], again[k]) for k in again)
+    with pytest.raises(DataFileError, match="kind carry"):
+        argdata.build(folder, 5, seed=2, progress=False)  # a drawn build into a carry folder: refused
+    with pytest.raises(ValueError, match="not joined"):
+        argdata.build(tmp_path / "other", 5, seed=2, progress=False, kind="carry", joined=0.3)
+    with pytest.raises(ValueError, match="unknown kind"):
+        argdata.build(tmp_path / "other", 5, kind="enumerated")
+
+
+def test_relu_evidence_lets_an_example_that_shows_nothing_say_nothing(tiny):
+    import jax.numpy as jnp
+
+    d = argdata.load(tiny)
+    from argpred.features import features_from_cells
+
+    x = jnp.asarray(features_from_cells(d["inputs"][:4], d["outputs"][:4]))  # (4, 10, 21, 15, 15)
+    mask7 = jnp.ones((4, 10)).at[:, 7:].set(0)
+    model, params, _ = train(d, TrainSettings(hidden=4, epochs=2, batch=8), progress=False)  # relu: the default
+    seven = model.apply({"params": params}, x, mask7)
+    ten = model.apply({"params": params}, x, jnp.ones((4, 10)))
+    assert (np.asarray(ten) >= np.asarray(seven) - 1e-6).all()  # more examples can only add evidence
+    # every position's logit below zero (positive hidden units, negative output kernel): under
+    # the paper's signed sum the three examples added lower every label; under relu they say nothing
+    import jax
+
+    for evidence, lowered in (("signed", True), ("relu", False)):
+        m = ArgNet(hidden=4, evidence=evidence)
+        p = jax.tree.map(lambda w: w, init_params(m, 0))
+        p["conv_hidden"]["bias"] = jnp.ones_like(p["conv_hidden"]["bias"])  # every hidden unit > 0 everywhere
+        p["conv_out"]["kernel"] = -jnp.abs(p["conv_out"]["kernel"])
+        seven = np.asarray(m.apply({"params": p}, x, mask7))
+        ten = np.asarray(m.apply({"params": p}, x, jnp.ones((4, 10))))
+        assert (ten < seven - 1e-6).all() if lowered else np.array_equal(ten, seven)
+
+
+def test_an_ensemble_averages_its_members_and_round_trips(tiny, tmp_path):
+    from argpred.train import train_members
+    from argpred.weights import members_of
+
+    d = argdata.load(tiny)
+    settings = TrainSettings(hidden=4, epochs=2, batch=8)
+    model, stacked, histories = train_members(d, settings, 2, checkpoint=tmp_path / "e.ckpt", progress=False)
+    assert members_of(stacked) == 2 and len(histories) == 2
+    assert (tmp_path / "e.m0.ckpt").exists() and (tmp_path / "e.m1.ckpt").exists()  # each resumable
+    save(tmp_path / "e.msgpack", model, stacked)
+    _, _, card = load(tmp_path / "e.msgpack")
+    assert card["model"]["members"] == 2
+    import jax
+
+    from argpred.features import features_from_cells
+
+    x = features_from_cells(d["inputs"][:3], d["outputs"][:3])
+    singles = []
+    for k in range(2):
+        save(tmp_path / f"m{k}.msgpack", model, jax.tree.map(lambda w, k=k: w[k], stacked))
+        singles.append(Predictor(tmp_path / f"m{k}.msgpack").probabilities(x))
+    np.testing.assert_allclose(Predictor(tmp_path / "e.msgpack").probabilities(x), np.mean(singles, axis=0),
+                               rtol=1e-5, atol=1e-6)
+    # member k is the single network trained from seed + k
+    _, alone, _ = train(d, TrainSettings(hidden=4, epochs=2, batch=8, seed=1), progress=False)
+    for a, b in zip(jax.tree.leaves(alone), jax.tree.leaves(jax.tree.map(lambda w: w[1], stacked))):
+        np.testing.assert_allclose(np.asarray(a), np.asarray(b), rtol=1e-5, atol=1e-6)
 
 
 def test_predicted_arguments_keep_only_those_that_pass():

@@ -264,3 +264,19 @@ def test_cli_induces_a_dozen_short_concepts_end_to_end(tmp_path, capsys):
     assert f"{'induced':<28}{summary['found']}" in text and "throughput" in text
     records = [json.loads(x) for x in (out / "results.jsonl").read_text().splitlines()]
     assert all(r["covered"] <= 20000 for r in records)
+
+
+def test_a_run_with_predicted_arguments_resumes_only_under_the_same_weights(tmp_path):
+    settings = Settings(budget=1000, args="predicted")
+    run = Run(tmp_path / "r", settings)
+    run.check_predictor("a" * 64)
+    run.append({"concept": "c", "iteration": 0, "found": False})
+    again = Run(tmp_path / "r", settings)
+    again.check_predictor("a" * 64)  # the same weights: resumes
+    with pytest.raises(DataFileError, match="other argument-predictor weights"):
+        Run(tmp_path / "r", settings).check_predictor("b" * 64)
+    (tmp_path / "r2").mkdir()
+    old = Run(tmp_path / "r2", settings)  # records made before the weights were recorded
+    old.append({"concept": "c", "iteration": 0, "found": False})
+    with pytest.raises(DataFileError, match="do not say which"):
+        Run(tmp_path / "r2", settings).check_predictor("a" * 64)
