@@ -80,6 +80,11 @@ def _cell(s: dict | None) -> str:
     return f"{s['found']} of {s['concepts']}{part}"
 
 
+def _weights(s: dict | None) -> str:
+    """Which argument-predictor weights a run used, where its run.json says."""
+    return f" (predictor `{s['predictor_sha256'][:8]}`)" if s and s.get("predictor_sha256") else ""
+
+
 def reproduce_section(rows: dict[str, dict]) -> list[str]:
     lines = ["## The paper's experiments (`vcc bench reproduce`)", "",
              "Each row is an explore-compress run of ours (`search.induce`) beside the paper's figure. "
@@ -92,7 +97,7 @@ def reproduce_section(rows: dict[str, dict]) -> list[str]:
             continue
         for key, s in _row_runs(rows, row.name) or [(row.name, None)]:
             lines.append(
-                f"| {row.name} | {row.what} | {row.paper} | {_cell(s)} | "
+                f"| {row.name} | {row.what}{_weights(s)} | {row.paper} | {_cell(s)} | "
                 + (f"{s['found_without_subroutines']} | {s['exact_on_all_test_pairs']} | "
                    f"{s['wall_seconds'] / 60:.0f} min | `{key}` |" if s else "- | - | - | - |"))
     curve = [(row, _row_runs(rows, row.name)) for row in rp.ROWS if row.short_only]
@@ -169,7 +174,7 @@ def other_runs_section(folder: Path) -> list[str]:
         if s is None:
             continue
         lines.append(f"| `{path}` | order {st.get('order')}, {st.get('args')} arguments, budget {st.get('budget'):,}, "
-                     f"subroutines {'on' if st.get('subroutines') else 'off'} | {_cell(s)} | "
+                     f"subroutines {'on' if st.get('subroutines') else 'off'}{_weights(s)} | {_cell(s)} | "
                      f"{s['found_without_subroutines']} | {s['exact_on_all_test_pairs']} | "
                      f"{s['wall_seconds'] / 60:.0f} min | {s['programs_per_second']:,} "
                      f"({s['programs_run_per_second']:,}) |")

@@ -128,7 +128,9 @@ def read_row(path: Path) -> dict | None:
     else:
         names = sorted(json.loads((path / "run.json").read_text()).get("examples_sha256", {}))
         s = {**summary(run, names), "complete": False}
-    return {**s, "row": row_of(path.name), "lengths_per_iteration": lengths(run.records)}
+    predictor = json.loads((path / "run.json").read_text()).get("predictor_sha256")
+    return {**s, "row": row_of(path.name), "lengths_per_iteration": lengths(run.records),
+            **({"predictor_sha256": predictor} if predictor else {})}
 
 
 def row_of(folder_name: str) -> str:
