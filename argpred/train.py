@@ -42,6 +42,11 @@ class TrainSettings:
     seed: int = 0
 
 
+def model_of(settings: TrainSettings) -> ArgNet:
+    return ArgNet(hidden=settings.hidden, kernel=settings.kernel, depth=settings.depth, evidence=settings.evidence,
+                  bias_start=settings.bias_start)
+
+
 def _l1(params) -> jax.Array:
     return sum(jnp.abs(w).sum() for path, w in jax.tree_util.tree_leaves_with_path(params)
                if "kernel" in jax.tree_util.keystr(path))
@@ -83,8 +88,7 @@ def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = N
     """Train on `data` (argpred.data.load); returns (model, params, per-epoch history)."""
     from tqdm import tqdm
 
-    model = ArgNet(hidden=settings.hidden, kernel=settings.kernel, depth=settings.depth, evidence=settings.evidence,
-                   bias_start=settings.bias_start)
+    model = model_of(settings)
     tx = optax.adam(settings.learning_rate)
     params = init_params(model, settings.seed)
     opt_state = tx.init(params)
@@ -157,9 +161,7 @@ def train_members(data: dict, settings: TrainSettings, members: int, checkpoint:
             done = list(tqdm(pool.map(_member, jobs), total=members, desc="argpred members", disable=not progress))
     else:
         done = [_member(job, progress) for job in jobs]
-    model = ArgNet(hidden=settings.hidden, kernel=settings.kernel, depth=settings.depth, evidence=settings.evidence,
-                   bias_start=settings.bias_start)
-    return model, stack([p for p, _ in done]), [h for _, h in done]
+    return model_of(settings), stack([p for p, _ in done]), [h for _, h in done]
 
 
 def _member(job, progress: bool = False):
