@@ -122,13 +122,13 @@ def read_row(path: Path) -> dict | None:
     if not (path / "run.json").exists():
         return None
     run = Run.view(path)
+    info = json.loads((path / "run.json").read_text())
     done = path / "summary.json"
     if done.exists():
         s = {"complete": True, **json.loads(done.read_text())}  # written when a run ends
     else:
-        names = sorted(json.loads((path / "run.json").read_text()).get("examples_sha256", {}))
-        s = {**summary(run, names), "complete": False}
-    predictor = json.loads((path / "run.json").read_text()).get("predictor_sha256")
+        s = {**summary(run, sorted(info.get("examples_sha256", {}))), "complete": False}
+    predictor = info.get("predictor_sha256")
     return {**s, "row": row_of(path.name), "lengths_per_iteration": lengths(run.records),
             **({"predictor_sha256": predictor} if predictor else {})}
 
