@@ -76,8 +76,8 @@ def cmd_train(a: argparse.Namespace) -> int:
 def cmd_recall(a: argparse.Namespace) -> int:
     from argpred.predict import Predictor
     from argpred.recall import recall
-    from vccjax.concepts import concept_names
-    from vccjax.dataset import dataset_for
+    from vccjax.world.concepts import concept_names
+    from vccjax.world.dataset import dataset_for
 
     names = concept_names() if a.concepts == "all" else [c.strip() for c in a.concepts.split(",") if c.strip()]
     ds = dataset_for(names, 0, a.dataset, progress=False)

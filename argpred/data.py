@@ -37,14 +37,14 @@ from pathlib import Path
 import numpy as np
 
 from argpred.features import MAX_OBJECTS, scene_cells
-from vccjax.config import DEFAULT_CONFIG
+from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import DataFileError, ProgramSyntaxError, SceneError
-from vccjax.examples import TRAIN, ExampleError, distinguishes, make_pairs
-from vccjax.generate import random_scene
-from vccjax.instructions import NAMES, OP, arg_domain
-from vccjax.program import Program, check_loop_syntax
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene, scenes_match
+from vccjax.world.pairs import TRAIN, ExampleError, distinguishes, make_pairs
+from vccjax.world.scenes import random_scene
+from vccjax.machine.instructions import NAMES, OP, arg_domain
+from vccjax.machine.program import Program, check_loop_syntax
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, scenes_match
 
 PREDICTED: tuple[str, ...] = ("set_shape_attn", "set_color_attn", "fill_color")
 LABELS: tuple[tuple[str, str], ...] = tuple((f, v) for f in PREDICTED for v in arg_domain(f))

@@ -1,7 +1,7 @@
 """What the argument predictor sees of an example pair (paper, "Argument prediction").
 
 Per example a (21, 15, 15) array on the machine's 15x15 grid (an object is at the cell
-of its centre, `floor(position * 14)` as `vccjax.state.grid15`):
+of its centre, `floor(position * 14)` as `vccjax.machine.state.grid15`):
 - channels 0-9, the input: 5 shapes, 4 colours, the pointer (binary);
 - channels 10-19, output minus input in the same encoding (-1, 0, 1);
 - channel 20, 1 where any of channels 10-19 is non-zero (something changed there).
@@ -16,8 +16,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from vccjax.instructions import COLORS, SHAPES
-from vccjax.scene import Scene
+from vccjax.machine.instructions import COLORS, SHAPES
+from vccjax.machine.scene import Scene
 
 GRID = 15
 CHANNELS = 21

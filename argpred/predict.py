@@ -15,8 +15,8 @@ import numpy as np
 from argpred.data import LABELS, PREDICTED
 from argpred.features import pair_features
 from argpred.weights import load, members_of
-from vccjax.instructions import arg_domain
-from vccjax.scene import Scene
+from vccjax.machine.instructions import arg_domain
+from vccjax.machine.scene import Scene
 
 THRESHOLD = 0.55
 

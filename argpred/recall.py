@@ -12,9 +12,9 @@ import numpy as np
 
 from argpred.data import PREDICTED
 from argpred.predict import Predictor, passing
-from vccjax.concepts import reference_program
-from vccjax.instructions import NAMES, arg_domain
-from vccjax.scene import Scene
+from vccjax.world.concepts import reference_program
+from vccjax.machine.instructions import NAMES, arg_domain
+from vccjax.machine.scene import Scene
 
 
 def used_arguments(concept: str) -> dict[str, set[str]]:

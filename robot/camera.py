@@ -2,7 +2,7 @@
 
 The image goes through the camera's calibration (pinhole model from the MJCF camera:
 its pose and field of view) into a top-down view of the workspace square, and from
-there through the project's own OpenCV `scene_parse` (`vccjax.perception`), exactly
+there through the project's own OpenCV `scene_parse` (`vccjax.vision.perception`), exactly
 as a schematic image would. The table plane is taken at `PLANE_Z`, about mid-height of
 the objects, so that an object's silhouette is centred where its body is.
 """
@@ -14,8 +14,8 @@ import mujoco
 import numpy as np
 
 from robot.world import to_table
-from vccjax.perception import parse_image
-from vccjax.scene import Scene
+from vccjax.vision.perception import parse_image
+from vccjax.machine.scene import Scene
 
 IMAGE = 640  # rendered pixels per side
 VIEW = 384  # pixels per side of the rectified workspace image

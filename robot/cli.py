@@ -4,19 +4,17 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 from collections import Counter
 from pathlib import Path
 
-XLA_FLAG = "--xla_cpu_use_fusion_emitters=false"  # batched MJX 14x faster on CPU (shared/notes/mjx-on-cpu.md)
+from vccjax import runtime
+
+XLA_FLAG = "--xla_cpu_use_fusion_emitters=false"  # batched MJX 14x faster on CPU (docs/robot.md, "MJX on CPU")
 
 
 def _program(a: argparse.Namespace):
-    from vccjax.program import parse
-
     if a.program:
-        text = Path(a.program).read_text() if Path(a.program).is_file() else a.program
-        return parse(text)
+        return runtime.program_from_arg(a.program)
     from robot.suite import programs_of
 
     return programs_of(a.concept, a.induced)
@@ -58,21 +56,11 @@ def cmd_run(a: argparse.Namespace) -> int:
     return 0
 
 
-def prepare_process(argv: list[str]) -> None:
-    """Before JAX starts (importing vccjax starts it, so `vcc` calls this first for `vcc
-    robot`): the XLA flag that makes batched MJX fast on CPU, and one core (batched MJX
-    on both cores of this CPU hung inside XLA's batched Cholesky, batch 32, twice in two
-    tries; pinned to one core it runs, as fast: shared/notes/mjx-on-cpu.md)."""
-    if XLA_FLAG not in os.environ.get("XLA_FLAGS", ""):
-        os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " " + XLA_FLAG).strip()
-    if hasattr(os, "sched_setaffinity") and "--all-cores" not in argv:
-        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
-
-
 def _setup_mjx(a: argparse.Namespace) -> None:
-    from search.cli import enable_compile_cache
-
-    enable_compile_cache()
+    """Before JAX starts: the XLA flag that makes batched MJX fast on CPU, and one core
+    unless --all-cores (batched MJX on both cores of a 2-core CPU hung inside XLA's batched
+    Cholesky; pinned to one core it runs as fast: docs/robot.md, "MJX on CPU")."""
+    runtime.prepare(xla_flags=[XLA_FLAG], cores=None if a.all_cores else 1)
 
 
 def cmd_suite(a: argparse.Namespace) -> int:

@@ -16,12 +16,12 @@ import cv2
 import numpy as np
 
 from robot.world import WORKSPACE_SIDE
-from vccjax.config import VCCConfig
-from vccjax.geometry import object_pixels
-from vccjax.instructions import NAMES, SHAPES
-from vccjax.program import Program
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene
+from vccjax.machine.config import VCCConfig
+from vccjax.machine.geometry import object_pixels
+from vccjax.machine.instructions import NAMES, SHAPES
+from vccjax.machine.program import Program
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene
 
 # instructions that move the held object (spec: carries); the rest never move the arm
 _CARRIES = {"move_hand_left", "move_hand_right", "move_hand_up", "move_hand_down", "move_hand_to_pointer",

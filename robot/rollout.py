@@ -24,8 +24,8 @@ from robot.motion import keyframes
 from robot.plan import PickPlace, PlanError, plan
 from robot.scenario import Scenario, draw
 from vccjax.errors import SceneError
-from vccjax.program import Program
-from vccjax.scene import Scene
+from vccjax.machine.program import Program
+from vccjax.machine.scene import Scene
 
 
 

@@ -18,11 +18,11 @@ import numpy as np
 from robot.mjcf import HOME, N_DISTRACTORS, parked_xy
 from robot.world import APART, BODIES, COLORS_RGB, TEXTURES, WORKSPACE_SIDE, to_table
 from vccjax.errors import SceneError
-from vccjax.examples import uses_pointer
-from vccjax.instructions import COLORS
-from vccjax.program import Program
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene, SceneObject, scenes_match
+from vccjax.world.pairs import uses_pointer
+from vccjax.machine.instructions import COLORS
+from vccjax.machine.program import Program
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, SceneObject, scenes_match
 
 GAP = 0.035 / WORKSPACE_SIDE  # workspace units between bounding boxes: the fingers' room
 OBJECTS = (2, 5)
@@ -147,8 +147,8 @@ def _distractors(rng: np.random.Generator) -> tuple[tuple[float, float, float], 
 def arm_concepts() -> list[str]:
     """Concepts whose reference program an arm can carry out: it grabs something, and
     neither recolours nor removes objects nor imagines them."""
-    from vccjax.concepts import concept_names, reference_program
-    from vccjax.instructions import NAMES
+    from vccjax.world.concepts import concept_names, reference_program
+    from vccjax.machine.instructions import NAMES
 
     from robot.plan import NOT_ON_A_ROBOT
 

@@ -19,7 +19,7 @@ def draw_batch(seed: int, batch: int, size: int = BATCH) -> list:
     """`size` (program, scenario) pairs: concepts drawn uniformly from the arm's concepts,
     a concept that no scenario of the arm's bodies lets run is drawn again."""
     from robot.scenario import arm_concepts, draw
-    from vccjax.concepts import reference_program
+    from vccjax.world.concepts import reference_program
     from vccjax.errors import SceneError
 
     rng = np.random.default_rng([seed, batch])

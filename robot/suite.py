@@ -27,7 +27,7 @@ SUITE: tuple[str, ...] = (
 def induced_programs(run: str | Path) -> dict:
     """{concept: Program} a `vcc induce` run found (its results.jsonl; a later record wins)."""
     from vccjax.errors import DataFileError
-    from vccjax.program import parse
+    from vccjax.machine.program import parse
 
     path = Path(run) / "results.jsonl"
     if not path.is_file():
@@ -46,7 +46,7 @@ def induced_programs(run: str | Path) -> dict:
 def programs_of(name: str, induced: str | Path | None = None):
     """A concept's program: the reference one, or the one a `vcc induce` run in folder
     `induced` found; for A+B, A's then B's (run on the scene A leaves)."""
-    from vccjax.concepts import concept_names, reference_program
+    from vccjax.world.concepts import concept_names, reference_program
 
     parts = name.split("+")
     unknown = [c for c in parts if c not in concept_names()]

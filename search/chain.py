@@ -22,7 +22,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from search.model import MarkovModel, Vocabulary
-from vccjax.instructions import FORBIDDEN_IN_LOOP, NAMES, OP, arg_domain
+from vccjax.machine.instructions import FORBIDDEN_IN_LOOP, NAMES, OP, arg_domain
 
 NOT_STARTED, OUTSIDE = 0, 1  # then 2 + flags (1: top_down_attend seen, 2: next_object seen)
 N_SYN = 6

@@ -4,47 +4,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 from pathlib import Path
 
-
-def enable_compile_cache() -> None:
-    """Keep compiled emulator steps across runs (XLA's persistent cache); VCCJAX_CACHE=off
-    turns it off, another value moves it."""
-    where = os.environ.get("VCCJAX_CACHE", str(Path.home() / ".cache" / "vccjax" / "jax"))
-    if where.lower() == "off":
-        return
-    import jax
-
-    jax.config.update("jax_compilation_cache_dir", where)
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
-
-
-DEMO: tuple[str, ...] = (  # a dozen short concepts: `--concepts demo` (all found in under a minute on 2 cores)
-    "change_target_obj_to_given_color", "change_target_position_to_given_color", "remove_bottom_obj",
-    "remove_given_target_color_objs", "remove_given_target_shape_objs", "remove_left_most_obj",
-    "remove_right_most_obj", "remove_top_obj", "remove_given_target_shape_and_color_combo_objs",
-    "move_to_bottom_edge", "move_to_right_edge", "move_to_top_edge")
-
-
-def concept_list(spec: str) -> list[str]:
-    from vccjax.concepts import concept_names
-
-    names = concept_names()
-    if spec == "all":
-        return names
-    if spec == "demo":
-        return list(DEMO)
-    chosen = [c.strip() for c in spec.split(",") if c.strip()]
-    unknown = [c for c in chosen if c not in names]
-    if unknown:
-        raise ValueError(f"unknown concept(s): {', '.join(unknown)} (see `vcc concepts`)")
-    return chosen
+from vccjax import runtime
+from vccjax.world.concepts import concept_list
 
 
 def cmd_induce(a: argparse.Namespace) -> int:
     from search.induce import Settings, induce, summary
-    from vccjax.dataset import dataset_for
+    from vccjax.world.dataset import dataset_for
 
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations)
@@ -53,7 +21,7 @@ def cmd_induce(a: argparse.Namespace) -> int:
         from argpred.predict import default_predictor
 
         default_predictor()  # a missing or corrupt weights file fails now, with its message
-    enable_compile_cache()
+    runtime.prepare()
     ds = dataset_for(names, a.seed, a.dataset, progress=not a.quiet)
     from search.explore import Explorer
 

@@ -13,7 +13,7 @@ import collections
 from collections.abc import Sequence
 
 from search.model import Vocabulary, collection_dl
-from vccjax.instructions import OP
+from vccjax.machine.instructions import OP
 
 _START, _END = OP["loop_start"], OP["loop_end"]
 

@@ -31,14 +31,15 @@ from jax.sharding import Mesh, NamedSharding
 from jax.sharding import PartitionSpec as P
 
 from search.chain import NOT_STARTED, OUTSIDE, Chain, cutoff_for_budget
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.emulator import EMPTY_HANDED, loop_needs_iteration, replay_examples, step_examples
-from vccjax.explain import ASK, YES, Target, load_target, verdict
-from vccjax.instructions import NAMES, OP, arg_domain
-from vccjax.program import Program
-from vccjax.scene import Scene, scenes_match
-from vccjax.state import (SceneConst, blackboard_columns, init_state, load_scene, output_scene, pack_state,
-                          packed_field, stack, unpack_blackboard, unpack_state)
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.match import ASK, YES, Target, load_target, verdict
+from vccjax.machine.instructions import NAMES, OP, arg_domain
+from vccjax.machine.program import Program
+from vccjax.machine.scene import Scene, scenes_match
+from vccjax.machine.state import SceneConst, init_state, load_scene, output_scene, stack
+
+from search.packing import blackboard_columns, pack_state, packed_field, unpack_blackboard, unpack_state
+from search.stepping import EMPTY_HANDED, loop_needs_iteration, replay_examples, step_examples
 
 MAX_PORTIONS = 40
 

@@ -30,13 +30,13 @@ from search.chain import Chain, uniform_args
 from search.compress import compress
 from search.explore import Explorer, Result, Task
 from search.model import MarkovModel, Vocabulary
-from vccjax.concepts import reference_program
-from vccjax.config import DEFAULT_CONFIG
+from vccjax.world.concepts import reference_program
+from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import DataFileError
-from vccjax.instructions import NAMES, OP, arg_domain
-from vccjax.program import Program, parse
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene, scenes_match
+from vccjax.machine.instructions import NAMES, OP, arg_domain
+from vccjax.machine.program import Program, parse
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, scenes_match
 
 ARG_MODES = ("uniform", "oracle", "uniform+fixation", "predicted", "predicted+fixation")
 

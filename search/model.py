@@ -14,8 +14,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from vccjax.instructions import N_OPS, NAMES
-from vccjax.program import Subroutine
+from vccjax.machine.instructions import N_OPS, NAMES
+from vccjax.machine.program import Subroutine
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,7 +50,7 @@ class Vocabulary:
         return Vocabulary(self.bodies + (tuple(body),))
 
     def subroutines(self) -> dict[str, Subroutine]:
-        """As `vccjax.program.Subroutine`s, for `parse(text, library)`."""
+        """As `vccjax.machine.program.Subroutine`s, for `parse(text, library)`."""
         return {self.name(N_OPS + i): Subroutine(self.name(N_OPS + i), tuple(self.name(u) for u in b))
                 for i, b in enumerate(self.bodies)}
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from search.explore import Explorer, Request, Task
-from vccjax.reference import RefMachine
-from vccjax.scene import scenes_match
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import scenes_match
 
 
 class ScalarExplorer(Explorer):

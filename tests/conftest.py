@@ -10,12 +10,12 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.emulator import pad_length, run_program
-from vccjax.program import Program, parse
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene, SceneObject
-from vccjax.state import VCCState, load_scene
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.step import pad_length, run_program
+from vccjax.machine.program import Program, parse
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, SceneObject
+from vccjax.machine.state import VCCState, load_scene
 
 
 def obj(shape: str, color: str, x: float, y: float, w: float = 0.1) -> SceneObject:

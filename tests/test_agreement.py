@@ -15,13 +15,14 @@ import numpy as np
 import pytest
 from conftest import summary_jax, summary_ref
 
-from vccjax import emulator
-from vccjax.config import DEFAULT_CONFIG as CFG
-from vccjax.generate import random_deep_program, random_program, random_scene
-from vccjax.instructions import N_OPS, NAMES
-from vccjax.reference import RefMachine
-from vccjax.scene import scenes_match
-from vccjax.state import init_state, load_scene, output_scene, stack
+from vccjax.machine import step as emulator
+from vccjax.machine.config import DEFAULT_CONFIG as CFG
+from vccjax.world.programs import random_deep_program, random_program
+from vccjax.world.scenes import random_scene
+from vccjax.machine.instructions import N_OPS, NAMES
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import scenes_match
+from vccjax.machine.state import init_state, load_scene, output_scene, stack
 
 LENGTH = 32  # programs are padded to this length: one compiled shape for every case
 BATCH = 500
@@ -78,7 +79,7 @@ def test_jax_and_reference_agree_on_2000_random_cases():
 @pytest.mark.parametrize("raster", [32, 48, 128])
 def test_agreement_at_other_raster_sizes(raster):
     """The raster is configurable: one word per row (32), a partial second word (48), four (128)."""
-    from vccjax.config import VCCConfig
+    from vccjax.machine.config import VCCConfig
 
     cfg = VCCConfig(raster=raster)
     stats = check_cases(make_cases(seed=raster, n=150, cfg=cfg), cfg, batch=150)
@@ -103,7 +104,7 @@ def test_step_batch_grouped_by_instruction_matches_whole_program_runs():
         for op in np.unique(ops[:, t]):
             if op < 0:
                 continue
-            stepped = emulator.step_batch(CFG, int(op), consts, states, args[:, t])
+            stepped = emulator.step_batch(CFG, consts, states, int(op), args[:, t])
             pick = jnp.asarray(ops[:, t] == op)
             states = jax.tree.map(
                 lambda new, old: jnp.where(pick.reshape((-1,) + (1,) * (new.ndim - 1)), new, old),
@@ -149,8 +150,8 @@ def test_no_retracing_across_programs_and_scenes():
 def test_derived_raster_masks_and_grid_match_the_reference_pixels():
     """The full-resolution masks derived from the JAX state are the reference's pixel sets,
     after motion too; the 15x15 grid cell is floor(position * 14)."""
-    from vccjax.motion import imagined_runs
-    from vccjax.state import grid15, object_masks
+    from vccjax.machine.motion import imagined_runs
+    from vccjax.machine.state import grid15, object_masks
 
     rng = np.random.default_rng(17)
     checked = 0
@@ -182,9 +183,10 @@ def test_derived_raster_masks_and_grid_match_the_reference_pixels():
 
 @pytest.mark.parametrize("holding", [False, True])
 def test_carry_ops_skip_the_carry_only_when_nothing_is_held(holding):
-    """`emulator.EMPTY_HANDED`: a batch with no object held runs a cheaper stand-in; it
-    must give what the full op gives (and what the reference gives)."""
-    from vccjax.program import parse
+    """`search.stepping.EMPTY_HANDED`: a search batch with no object held runs a cheaper
+    stand-in; it must give what the full op gives (and what the reference gives)."""
+    from search.stepping import EMPTY_HANDED, step_examples
+    from vccjax.machine.program import parse
 
     rng = np.random.default_rng(21)
     scenes = [random_scene(rng, (2, 6), pointer=True) for _ in range(16)]
@@ -193,9 +195,12 @@ def test_carry_ops_skip_the_carry_only_when_nothing_is_held(holding):
     consts = stack([load_scene(s) for s in scenes])
     states = emulator.run_batch(CFG, consts, *(jnp.asarray(a) for a in parse(prefix).arrays(LENGTH)[:2]))
     assert bool(jnp.any(states.held >= 0)) == holding
-    for op in emulator.EMPTY_HANDED:
-        batched = emulator.step_batch(CFG, op, consts, states, jnp.zeros(len(scenes), jnp.int32))
-        full = jax.vmap(lambda c, s, op=op: emulator.step_op(CFG, op, c, s, jnp.int32(0)))(consts, states)
+    one_example = lambda t: jax.tree.map(lambda x: x[:, None], t)  # noqa: E731  each scene a task of 1 example
+    tasks, zeros = jnp.arange(len(scenes)), jnp.zeros(len(scenes), jnp.int32)
+    for op in EMPTY_HANDED:
+        batched = step_examples(CFG, op, one_example(consts), tasks, one_example(states), zeros)
+        batched = jax.tree.map(lambda x: x[:, 0], batched)
+        full = jax.vmap(lambda c, s, op=op: emulator.step_op(CFG, c, s, op, jnp.int32(0)))(consts, states)
         host_b, host_f, host_c = jax.device_get((batched, full, consts))
         for i, sc in enumerate(scenes):
             pick = lambda t, i=i: jax.tree.map(lambda x: x[i], t)  # noqa: E731
@@ -215,8 +220,8 @@ def test_imagined_runs_in_closed_form_are_the_footprint_lines():
     """Contact remakes the imagined object's per-line runs from its kind and position in
     closed form; they must be exactly the lines of the footprint (geometry.imagined_pixels),
     at any position (off the workspace too) and for no imagined object."""
-    from vccjax.geometry import imagined_pixels
-    from vccjax.motion import imagined_runs
+    from vccjax.machine.geometry import imagined_pixels
+    from vccjax.machine.motion import imagined_runs
 
     runs = jax.jit(jax.vmap(lambda k, a: imagined_runs(k, a, CFG)))
     u = CFG.units

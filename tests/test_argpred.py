@@ -15,8 +15,8 @@ from argpred.train import TrainSettings, train
 from argpred.model import ArgNet
 from argpred.weights import init_params, load, save
 from vccjax.errors import DataFileError
-from vccjax.program import parse
-from vccjax.scene import Scene, SceneObject
+from vccjax.machine.program import parse
+from vccjax.machine.scene import Scene, SceneObject
 
 
 def test_features_of_a_hand_built_pair_mean_what_the_channels_say():
@@ -55,7 +55,7 @@ def test_drawn_programs_pass_the_filters_and_are_labelled():
     both = Scene((SceneObject("square", "red", 0.3, 0.3, 0.1), SceneObject("square", "red", 0.7, 0.7, 0.1)))
     loop = parse("scene_parse; set_shape_attn(square); loop_start; top_down_attend; fill_color(blue); "
                  "next_object; loop_end")
-    from vccjax.reference import RefMachine
+    from vccjax.machine.reference import RefMachine
 
     out = RefMachine(both).run(loop).output_scene()
     assert not argdata.indispensable(loop, [(both, out)])

@@ -7,11 +7,11 @@ import json
 import pytest
 from conftest import obj, scene
 
-from vccjax.config import VCCConfig
+from vccjax.machine.config import VCCConfig
 from vccjax.errors import ProgramSyntaxError, SceneError
-from vccjax.program import Program, Subroutine, expand, parse
-from vccjax.scene import Scene
-from vccjax.state import load_scene
+from vccjax.machine.program import Program, Subroutine, expand, parse
+from vccjax.machine.scene import Scene
+from vccjax.machine.state import load_scene
 
 
 @pytest.mark.parametrize(

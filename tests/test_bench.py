@@ -45,8 +45,8 @@ def test_the_recorded_stream_is_what_the_search_steps_first():
     from search.induce import Settings, argument_logp
     from search.model import MarkovModel, Vocabulary
     from vcc.emulator_bench import record_stream
-    from vccjax.dataset import dataset_for
-    from vccjax.instructions import OP
+    from vccjax.world.dataset import dataset_for
+    from vccjax.machine.instructions import OP
 
     ds = dataset_for(["remove_bottom_obj"], 0, None, progress=False)
     chain = Chain(Vocabulary(), MarkovModel.uniform(Vocabulary().size, 1),

@@ -41,7 +41,7 @@ def test_scene_sources_and_their_mistakes_are_one_line_errors(capsys, tmp_path):
     import cv2
     import numpy as np
 
-    from vccjax.dataset import shipped_folder
+    from vccjax.world.dataset import shipped_folder
 
     argv = ["run", "--concept", "swap_locations", "--example", "2", "--split", "test", "--engine", "reference"]
     assert main(argv) == 0

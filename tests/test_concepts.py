@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 from conftest import obj, run_both, scene, summary_jax, summary_ref
 
-from vccjax import emulator
-from vccjax.concepts import LICENSE, all_concepts, concept_names, reference_program
-from vccjax.config import DEFAULT_CONFIG as CFG
-from vccjax.generate import random_scene
-from vccjax.program import check_loop_syntax
-from vccjax.reference import RefMachine
-from vccjax.scene import scenes_match
-from vccjax.state import load_scene, stack
+from vccjax.machine import step as emulator
+from vccjax.world.concepts import LICENSE, all_concepts, concept_names, reference_program
+from vccjax.machine.config import DEFAULT_CONFIG as CFG
+from vccjax.world.scenes import random_scene
+from vccjax.machine.program import check_loop_syntax
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import scenes_match
+from vccjax.machine.state import load_scene, stack
 
 TAU = CFG.tau
 

@@ -7,15 +7,15 @@ import json
 import numpy as np
 import pytest
 
-from vccjax.concepts import concept_names, reference_program
-from vccjax.config import DEFAULT_CONFIG as CFG
-from vccjax.dataset import Dataset, build_dataset, read_npz, shipped_folder, write_npz
+from vccjax.world.concepts import concept_names, reference_program
+from vccjax.machine.config import DEFAULT_CONFIG as CFG
+from vccjax.world.dataset import Dataset, build_dataset, read_npz, shipped_folder, write_npz
 from vccjax.errors import DataFileError
-from vccjax.examples import TEST, TRAIN, TRAIN_WIDE, Jitter, distinguishes, is_well_posed, uses_pointer
-from vccjax.program import parse
-from vccjax.reference import RefMachine
-from vccjax.rivals import rival_programs
-from vccjax.scene import Scene, SceneObject, scenes_match
+from vccjax.world.pairs import TEST, TRAIN, TRAIN_WIDE, Jitter, distinguishes, is_well_posed, uses_pointer
+from vccjax.machine.program import parse
+from vccjax.machine.reference import RefMachine
+from vccjax.world.rivals import rival_programs
+from vccjax.machine.scene import Scene, SceneObject, scenes_match
 
 SOME = ["swap_locations", "form_circle_shape_using_same_objs", "chained_movement_left_most_object",
         "move_<COLOR>_objects_to_touch_imagined_horizontal_line_at_top_pointer"]
@@ -165,17 +165,19 @@ def test_corrupt_and_foreign_files_are_refused(small, tmp_path):
 
 def test_examples_survive_rendering_and_parsing(small):
     """End to end: the program run on the parsed input image gives the stored output."""
-    from vccjax.perception_eval import end_to_end
+    from vccjax.vision.measure import end_to_end
 
     r = end_to_end(str(small), "varied", pairs=20, concepts=SOME, progress=False)
     assert r["concepts_at_least_99pct"] == len(SOME), r["misses"]
 
 
 def test_image_pairs_render_both_sides(small):
+    from vccjax.vision.render import render_pairs
+
     ds = Dataset(small)
-    pairs = ds.image_pairs(SOME[0], "train", style="schematic", size=128)
+    pairs = render_pairs(ds.pairs(SOME[0], "train"), style="schematic", size=128)
     assert len(pairs) == TRAIN.count
     a, b = pairs[0]
     assert a.shape == b.shape == (128, 128, 3) and a.dtype == np.uint8 and not np.array_equal(a, b)
-    again = ds.image_pairs(SOME[0], "train", style="schematic", size=128)
+    again = render_pairs(ds.pairs(SOME[0], "train"), style="schematic", size=128)
     assert all(np.array_equal(x, y) for p, q in zip(pairs, again) for x, y in zip(p, q))

@@ -1,4 +1,4 @@
-"""vccjax/explain.py: the on-device verdict (YES / NO / ASK) of a state against an output
+"""vccjax/machine/match.py: the on-device verdict (YES / NO / ASK) of a state against an output
 scene agrees with the host's `scenes_match`."""
 
 from __future__ import annotations
@@ -10,14 +10,15 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from vccjax import emulator
-from vccjax.config import DEFAULT_CONFIG as CFG
-from vccjax.explain import ASK, BAND, NO, YES, load_target, verdict
-from vccjax.generate import random_deep_program, random_program, random_scene
-from vccjax.program import parse
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene, SceneObject, scenes_match
-from vccjax.state import load_scene
+from vccjax.machine import step as emulator
+from vccjax.machine.config import DEFAULT_CONFIG as CFG
+from vccjax.machine.match import ASK, BAND, NO, YES, load_target, verdict
+from vccjax.world.programs import random_deep_program, random_program
+from vccjax.world.scenes import random_scene
+from vccjax.machine.program import parse
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, SceneObject, scenes_match
+from vccjax.machine.state import load_scene
 
 LENGTH = 32  # one padded length: one compilation
 N_CASES = 200

@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vccjax.config import DEFAULT_CONFIG as CFG
-from vccjax.examples import Jitter, _nudges
-from vccjax.generate import drawn_cover, random_scene
-from vccjax.geometry import object_pixels
-from vccjax.instructions import SHAPES
-from vccjax.render import shape_polygon
-from vccjax.scene import Scene, SceneObject, to_units
+from vccjax.machine.config import DEFAULT_CONFIG as CFG
+from vccjax.world.pairs import Jitter, _nudges
+from vccjax.world.scenes import drawn_cover, random_scene
+from vccjax.machine.geometry import object_pixels
+from vccjax.machine.instructions import SHAPES
+from vccjax.machine.geometry import shape_polygon
+from vccjax.machine.scene import Scene, SceneObject, to_units
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -84,3 +84,17 @@ def test_nudges_cover_every_direction_and_stay_in_bounds():
         assert np.allclose(np.subtract(t.pointer, sc.pointer) / j.pointer, d[0] / j.centre)
         angles.add(round(float(np.degrees(np.arctan2(d[0, 1], d[0, 0]))) % 360))
     assert angles == {0, 45, 90, 135, 180, 225, 270, 315}
+
+
+def test_grow_is_cv2_dilate_with_a_square_kernel():
+    """Scene generation keeps objects apart with a numpy dilation (the world imports no
+    OpenCV); it must equal OpenCV's, which generated the shipped examples."""
+    import cv2
+
+    from vccjax.world.scenes import _grow
+
+    rng = np.random.default_rng(0)
+    for g in range(4):
+        for _ in range(20):
+            m = (rng.random((64, 64)) < 0.02).astype(np.uint8)
+            assert np.array_equal(cv2.dilate(m, np.ones((2 * g + 1, 2 * g + 1), np.uint8)) > 0, _grow(m > 0, g))

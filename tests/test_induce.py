@@ -13,8 +13,8 @@ from search.induce import Run, Settings, argument_logp, induce
 from search.model import MarkovModel, Vocabulary
 from search.scalar import ScalarExplorer
 from vcc.cli import main
-from vccjax.concepts import reference_program
-from vccjax.dataset import Dataset, build_dataset
+from vccjax.world.concepts import reference_program
+from vccjax.world.dataset import Dataset, build_dataset
 from vccjax.errors import DataFileError
 
 SHORT = ["remove_bottom_obj", "change_target_obj_to_given_color", "remove_left_most_obj"]
@@ -42,7 +42,7 @@ def _uniform_chain():
 def _loop_chain():
     """A model that likes loops (fitted on the reference programs: only to make loops
     likely here) so that `loop_end` and its host-driven replay are exercised."""
-    from vccjax.concepts import all_concepts
+    from vccjax.world.concepts import all_concepts
 
     v = Vocabulary()
     model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], v.size, 1, 0.1)
@@ -95,7 +95,7 @@ folder, concept, here = sys.argv[1:]
 sys.path.insert(0, here)
 from test_induce import _loop_chain
 from search.explore import Explorer, Task
-from vccjax.dataset import Dataset
+from vccjax.world.dataset import Dataset
 
 ex = Explorer()
 r = ex.search(_loop_chain(), Task.from_pairs(Dataset(folder).pairs(concept, "train")), 3000)
@@ -135,7 +135,7 @@ def test_brute_force_finds_the_reference_program_of_a_short_concept(ds, explorer
 
 def test_oracle_arguments_exclude_unused_instructions():
     lp = argument_logp(Settings(args="oracle"), "remove_bottom_obj")  # uses fixate(bottom) only
-    from vccjax.instructions import OP
+    from vccjax.machine.instructions import OP
 
     assert (lp[OP["fixate"]] == 0).sum() == 1
     assert all(v == float("-inf") for v in lp[OP["set_color_attn"]])
@@ -224,7 +224,7 @@ def test_cli_induce_errors_are_one_line(tmp_path, capsys, argv, msg, monkeypatch
 def test_cli_induce_refuses_a_dataset_without_the_concept_or_other_examples(tmp_path, capsys, monkeypatch):
     import shutil
 
-    from vccjax.dataset import shipped_folder
+    from vccjax.world.dataset import shipped_folder
 
     monkeypatch.setenv("VCCJAX_CACHE", "off")
     part = tmp_path / "part"

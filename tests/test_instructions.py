@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 from conftest import obj, run_both, scene
 
-from vccjax.config import DEFAULT_CONFIG
-from vccjax.geometry import imagined_pixels, object_pixels
-from vccjax.instructions import COLORS, FIXATE_TARGETS, IMAGINE_KINDS, NAMES, SHAPES, arg_domain
-from vccjax.scene import to_units
+from vccjax.machine.config import DEFAULT_CONFIG
+from vccjax.machine.geometry import imagined_pixels, object_pixels
+from vccjax.machine.instructions import COLORS, FIXATE_TARGETS, IMAGINE_KINDS, NAMES, SHAPES, arg_domain
+from vccjax.machine.scene import to_units
 
 CFG = DEFAULT_CONFIG
 U = CFG.units  # 1024 position units across

@@ -1,4 +1,4 @@
-"""Contact bitmaps of vccjax.motion against the objects' pixel masks, batched as the search runs them."""
+"""Contact bitmaps of vccjax.machine.motion against the objects' pixel masks, batched as the search runs them."""
 
 from __future__ import annotations
 
@@ -6,10 +6,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from vccjax import emulator, motion
-from vccjax.config import DEFAULT_CONFIG as CFG
-from vccjax.generate import random_deep_program, random_scene
-from vccjax.state import load_scene, object_masks, stack
+from vccjax.machine import motion
+from vccjax.machine import step as emulator
+from vccjax.machine.config import DEFAULT_CONFIG as CFG
+from vccjax.world.programs import random_deep_program
+from vccjax.world.scenes import random_scene
+from vccjax.machine.state import load_scene, object_masks, stack
 
 
 def _unpack(bits: np.ndarray) -> np.ndarray:

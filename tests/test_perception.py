@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from conftest import obj, scene
 
-from vccjax.config import DEFAULT_CONFIG as CFG
+from vccjax.machine.config import DEFAULT_CONFIG as CFG
 from vccjax.errors import SceneError
-from vccjax.perception import parse_image
-from vccjax.render import render
-from vccjax.scene import scenes_match
+from vccjax.vision.perception import parse_image
+from vccjax.vision.render import render
+from vccjax.machine.scene import scenes_match
 
 CLEAR = scene(obj("square", "red", 0.2, 0.2, 0.12), obj("circle", "green", 0.7, 0.25, 0.12),
               obj("diamond", "blue", 0.3, 0.7, 0.14), obj("triangle", "yellow", 0.75, 0.75, 0.12),

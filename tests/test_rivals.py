@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from vccjax.examples import TRAIN, Jitter, discriminate, distinguishes, make_pairs
-from vccjax.program import check_loop_syntax, parse
-from vccjax.reference import RefMachine
-from vccjax.rivals import rival_programs
-from vccjax.scene import scenes_match
+from vccjax.world.pairs import TRAIN, Jitter, discriminate, distinguishes, make_pairs
+from vccjax.machine.program import check_loop_syntax, parse
+from vccjax.machine.reference import RefMachine
+from vccjax.world.rivals import rival_programs
+from vccjax.machine.scene import scenes_match
 
 TWO_PARTS = parse(
     "scene_parse; set_color_attn(red); top_down_attend; move_hand_to_attended_object; grab_object; "

@@ -14,10 +14,10 @@ from robot.reference import rollout as c_rollout
 from robot.rollout import Bench, scenarios_for
 from robot.scenario import draw
 from robot.world import to_table, to_workspace
-from vccjax.concepts import reference_program
-from vccjax.program import parse
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene, SceneObject, scenes_match
+from vccjax.world.concepts import reference_program
+from vccjax.machine.program import parse
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, SceneObject, scenes_match
 
 STACK = "stack_in_place_horizontal_left"
 POINTED = "move_bottom_to_pointed"

@@ -22,10 +22,10 @@ from search.chain import (
 )
 from search.compress import candidates, compress, replace
 from search.model import MarkovModel, Vocabulary, collection_dl, transition_counts
-from vccjax.concepts import all_concepts
+from vccjax.world.concepts import all_concepts
 from vccjax.errors import ProgramSyntaxError
-from vccjax.instructions import N_OPS, NAMES, OP, arg_domain
-from vccjax.program import Program, check_loop_syntax
+from vccjax.machine.instructions import N_OPS, NAMES, OP, arg_domain
+from vccjax.machine.program import Program, check_loop_syntax
 
 LS, LE = OP["loop_start"], OP["loop_end"]
 

@@ -7,8 +7,9 @@ import jax
 import numpy as np
 
 from vccjax import load_scene, random_scene, run
-from vccjax.concepts import reference_program
-from vccjax.state import init_state, pack_state, packed_field, stack, unpack_state
+from vccjax.world.concepts import reference_program
+from search.packing import pack_state, packed_field, unpack_state
+from vccjax.machine.state import init_state, stack
 
 
 def _states():

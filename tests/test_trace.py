@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vccjax.concepts import reference_program
-from vccjax.dataset import dataset_for
-from vccjax.program import parse
-from vccjax.reference import run_reference
-from vccjax.scene import Scene, SceneObject, scenes_match
-from vccjax.trace import trace
-from vccjax.viewer import RED, panel, sheet, write_trace
+from vccjax.world.concepts import reference_program
+from vccjax.world.dataset import dataset_for
+from vccjax.machine.program import parse
+from vccjax.machine.reference import run_reference
+from vccjax.machine.scene import Scene, SceneObject, scenes_match
+from vccjax.views.trace import trace
+from vccjax.views.viewer import RED, panel, sheet, write_trace
 
 SWAP = "swap_locations"
 

@@ -43,12 +43,12 @@ def stamp() -> dict:
 
 def _search_jobs(a: argparse.Namespace):
     from search.chain import Chain
-    from search.cli import concept_list
+    from vccjax.world.concepts import concept_list
     from search.explore import Task
     from search.induce import Settings, argument_logp
     from search.model import MarkovModel, Vocabulary
-    from vccjax.concepts import all_concepts, concept_names
-    from vccjax.dataset import dataset_for
+    from vccjax.world.concepts import all_concepts, concept_names
+    from vccjax.world.dataset import dataset_for
 
     names = concept_list(a.concepts) if a.concepts else concept_names()[:: max(1, 546 // a.sample)][: a.sample]
     ds = dataset_for(names, 0, a.dataset, progress=False)
@@ -65,7 +65,7 @@ def _search_jobs(a: argparse.Namespace):
 def cmd_bench_search(a: argparse.Namespace) -> int:
     """The same concepts searched by the batched explorer (all concepts in lockstep) and by
     the scalar-driven one, same chains and budget: programs/s and their ratio."""
-    from search.cli import enable_compile_cache
+    from vccjax.runtime import enable_compile_cache
     from search.explore import Explorer
     from search.scalar import ScalarExplorer
 
@@ -129,9 +129,9 @@ def cmd_bench_emulator(a: argparse.Namespace) -> int:
     import numpy as np
 
     from vcc import emulator_bench as eb
-    from vccjax.instructions import NAMES
-    from vccjax.config import DEFAULT_CONFIG, VCCConfig
-    from vccjax.generate import random_scene
+    from vccjax.machine.instructions import NAMES
+    from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+    from vccjax.world.scenes import random_scene
 
     batches, objects, rasters = _ints(a.batch), _ints(a.objects), _ints(a.raster)
     a.model = "reference"  # a late iteration's model: the deep, mixed stream of the search's later work
@@ -179,7 +179,8 @@ def cmd_bench_emulator(a: argparse.Namespace) -> int:
 
 def cmd_bench_reproduce(a: argparse.Namespace) -> int:
     """Run the chosen rows (each resumable), then write the results JSON and the report."""
-    from search.cli import concept_list, enable_compile_cache
+    from vccjax.runtime import enable_compile_cache
+    from vccjax.world.concepts import concept_list
     from vcc import reproduce as rp
 
     rows = rp.select(a.rows)

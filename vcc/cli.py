@@ -1,20 +1,21 @@
-"""`vcc`: one command over all packages. It sits on top: nothing below imports it."""
+"""`vcc`: one command over all packages. It sits on top: nothing below imports it.
+
+Every package's CLI module imports only argparse-level code at the top, so building the
+parser starts no JAX backend; each command sets its process up (`vccjax.runtime.prepare`)
+before it touches a device.
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
-if len(sys.argv) > 1 and sys.argv[1] == "robot":  # MJX's XLA settings must precede JAX's start,
-    from robot.cli import prepare_process  # which importing vccjax triggers
-
-    prepare_process(sys.argv[2:])
-
-from argpred import cli as argpred_cli  # noqa: E402
-from robot import cli as robot_cli  # noqa: E402
-from search import cli as search_cli  # noqa: E402
-from vcc import bench  # noqa: E402
-from vccjax import cli as vccjax_cli  # noqa: E402
+from argpred import cli as argpred_cli
+from robot import cli as robot_cli
+from search import cli as search_cli
+from vcc import bench
+from vccjax import cli as vccjax_cli
+from vccjax import runtime
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -33,7 +34,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    return vccjax_cli.main(argv, build_parser())
+    return runtime.run_command(build_parser(), argv)
 
 
 if __name__ == "__main__":

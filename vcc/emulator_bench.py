@@ -22,13 +22,14 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from vccjax.config import VCCConfig
-from vccjax.emulator import loop_needs_iteration, replay_examples, run_batch, step_examples
-from vccjax.instructions import NAMES, OP
-from vccjax.program import Program
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene, scenes_match
-from vccjax.state import init_state, load_scene, output_scene, stack
+from vccjax.machine.config import VCCConfig
+from search.stepping import loop_needs_iteration, replay_examples, step_examples
+from vccjax.machine.step import run_batch
+from vccjax.machine.instructions import NAMES, OP
+from vccjax.machine.program import Program
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, scenes_match
+from vccjax.machine.state import init_state, load_scene, output_scene, stack
 
 
 class _Enough(Exception):

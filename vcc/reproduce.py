@@ -80,7 +80,7 @@ def concepts_of(row: Row, chosen: Sequence[str]) -> list[str]:
     iteration found: a uniform model reaches about this far)."""
     if not row.short_only:
         return list(chosen)
-    from vccjax.concepts import reference_program
+    from vccjax.world.concepts import reference_program
 
     return [c for c in chosen if len(reference_program(c)) <= SHORT]
 
@@ -98,7 +98,7 @@ def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset:
             progress: bool) -> dict:
     from search.explore import Explorer
     from search.induce import induce, summary
-    from vccjax.dataset import dataset_for
+    from vccjax.world.dataset import dataset_for
 
     names = concepts_of(row, concepts)
     ds = dataset_for(names, 0, dataset, progress=False)

@@ -8,45 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from vccjax.config import DEFAULT_CONFIG
+from vccjax import runtime
 from vccjax.errors import VCCError
-
-_SHAPE_CHAR = {"square": "#", "circle": "o", "diamond": "<>", "triangle": "^", "star": "*"}
-
-
-def ascii_scene(scene, cfg=DEFAULT_CONFIG, size: int = 32) -> list[str]:
-    """A scene drawn in characters: each object by its index, the pointer as '+'."""
-    from vccjax.geometry import object_pixels
-    from vccjax.scene import to_units
-
-    grid = np.full((size, size), ".", dtype="<U1")
-    f = cfg.raster // size
-    for i, o in enumerate(scene.objects):
-        rows, cols = object_pixels(o.shape, o.width, to_units(o.x, cfg), to_units(o.y, cfg), cfg)
-        ok = (rows >= 0) & (rows < cfg.raster) & (cols >= 0) & (cols < cfg.raster)
-        grid[rows[ok] // f, cols[ok] // f] = str(i % 10)
-    if scene.pointer is not None:
-        px, py = (min(int(v * size), size - 1) for v in scene.pointer)
-        grid[py, px] = "+"
-    return ["".join(r) for r in grid]
-
-
-def _legend(scene) -> list[str]:
-    return [f"{i}: {o.color:6s} {o.shape:8s} ({o.x:.3f}, {o.y:.3f}) w {o.width:.3f}"
-            for i, o in enumerate(scene.objects)]
-
-
-def _read_program(text: str | None):
-    from vccjax.program import parse
-
-    if text is None:
-        return None
-    path = Path(text)
-    if text.endswith((".vcc", ".txt")) or (path.suffix and path.exists()):
-        if not path.exists():
-            raise VCCError(f"{path}: no such program file")
-        text = path.read_text()
-    return parse(text, body_max=DEFAULT_CONFIG.body_max)
+from vccjax.machine.config import DEFAULT_CONFIG
+from vccjax.views.text import ascii_scene, legend
 
 
 def read_image(path: str):
@@ -65,13 +30,13 @@ def program_and_scene(a: argparse.Namespace):
     """(program, scene, note, expected output or None) from the shared flags of `vcc run`
     and `vcc trace`: PROGRAM or --concept; --scene, --image, --example K of the concept,
     or a seeded random scene."""
-    from vccjax.concepts import reference_program
-    from vccjax.generate import random_scene
-    from vccjax.reference import run_reference
-    from vccjax.scene import Scene, scenes_match
+    from vccjax.world.concepts import reference_program
+    from vccjax.world.scenes import random_scene
+    from vccjax.machine.reference import run_reference
+    from vccjax.machine.scene import Scene, scenes_match
 
     cfg = DEFAULT_CONFIG
-    program = _read_program(a.program)
+    program = None if a.program is None else runtime.program_from_arg(a.program)
     if program is None:
         if not a.concept:
             raise VCCError("give a PROGRAM, or --concept NAME to run its reference program")
@@ -84,7 +49,7 @@ def program_and_scene(a: argparse.Namespace):
     if a.scene:
         return program, Scene.load(a.scene).validate(cfg), f"scene {a.scene}", None
     if a.image:
-        from vccjax.perception import parse_image
+        from vccjax.vision.perception import parse_image
 
         image = read_image(a.image)
         try:
@@ -93,7 +58,7 @@ def program_and_scene(a: argparse.Namespace):
             raise VCCError(f"{a.image}: {e}") from None
         return program, scene, f"image {a.image} ({len(scene.objects)} objects parsed)", None
     if a.example is not None:
-        from vccjax.dataset import dataset_for
+        from vccjax.world.dataset import dataset_for
 
         pairs = dataset_for([a.concept], 0, a.dataset, progress=False).pairs(a.concept, a.split)
         if not 0 <= a.example < len(pairs):
@@ -111,10 +76,10 @@ def program_and_scene(a: argparse.Namespace):
 
 
 def cmd_run(a: argparse.Namespace) -> int:
-    from vccjax.emulator import run
-    from vccjax.reference import run_reference
-    from vccjax.scene import scenes_match
-    from vccjax.state import load_scene, output_scene
+    from vccjax.machine.step import run
+    from vccjax.machine.reference import run_reference
+    from vccjax.machine.scene import scenes_match
+    from vccjax.machine.state import load_scene, output_scene
 
     cfg = DEFAULT_CONFIG
     program, scene, note, expected = program_and_scene(a)
@@ -137,8 +102,8 @@ def cmd_run(a: argparse.Namespace) -> int:
     print(f"{'before':<34}after")
     for left, right in zip(before, after):
         print(f"{left}  {right}")
-    print("before:", *_legend(scene), sep="\n  ")
-    print("after:", *_legend(out), sep="\n  ")
+    print("before:", *legend(scene), sep="\n  ")
+    print("after:", *legend(out), sep="\n  ")
     print("changed" if not scenes_match(out, scene, cfg.tau) else "unchanged")
     if expected is not None:
         same = scenes_match(out, expected, cfg.tau)
@@ -148,8 +113,8 @@ def cmd_run(a: argparse.Namespace) -> int:
 
 
 def cmd_trace(a: argparse.Namespace) -> int:
-    from vccjax.trace import trace
-    from vccjax.viewer import write_trace
+    from vccjax.views.trace import trace
+    from vccjax.views.viewer import write_trace
 
     program, scene, note, _ = program_and_scene(a)
     outs = [o for o in a.out.split(",") if o]
@@ -168,7 +133,7 @@ def cmd_trace(a: argparse.Namespace) -> int:
 
 
 def cmd_concepts(a: argparse.Namespace) -> int:
-    from vccjax.concepts import all_concepts
+    from vccjax.world.concepts import all_concepts
 
     for name, p in all_concepts().items():
         if a.pattern is None or a.pattern.lower() in name.lower():
@@ -180,7 +145,7 @@ def cmd_dataset_build(a: argparse.Namespace) -> int:
     import os
     import time
 
-    from vccjax.dataset import build_dataset
+    from vccjax.world.dataset import build_dataset
 
     concepts = None if a.concepts in (None, "all") else [c.strip() for c in a.concepts.split(",") if c.strip()]
     start = time.time()
@@ -195,7 +160,7 @@ def cmd_dataset_build(a: argparse.Namespace) -> int:
 
 
 def cmd_dataset_info(a: argparse.Namespace) -> int:
-    from vccjax.dataset import Dataset
+    from vccjax.world.dataset import Dataset
 
     ds = Dataset(a.folder)
     for name in ds.concepts:  # verifies every file's hashes
@@ -209,7 +174,7 @@ def cmd_dataset_info(a: argparse.Namespace) -> int:
 def cmd_perception_evaluate(a: argparse.Namespace) -> int:
     import json
 
-    from vccjax.perception_eval import end_to_end, evaluate
+    from vccjax.vision.measure import end_to_end, evaluate
 
     for style in a.styles.split(","):
         if a.dataset:
@@ -297,14 +262,7 @@ def add_commands(sub) -> None:
 
 
 def main(argv: list[str] | None = None, parser: argparse.ArgumentParser | None = None) -> int:
-    args = (parser or build_parser()).parse_args(argv)
-    try:
-        return args.fn(args)
-    except (VCCError, KeyError, ValueError, NotImplementedError) as e:
-        msg = e.args[0] if isinstance(e, KeyError) and e.args else str(e)
-        print(f"vcc: error: {msg}", file=sys.stderr)
-        return 2
-
+    return runtime.run_command(parser or build_parser(), argv)
 
 if __name__ == "__main__":
     sys.exit(main())

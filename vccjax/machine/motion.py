@@ -22,8 +22,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from vccjax.config import VCCConfig
-from vccjax.state import SceneConst, VCCState
+from vccjax.machine.config import VCCConfig
+from vccjax.machine.state import SceneConst, VCCState
 
 _ONE = np.uint32(1)
 

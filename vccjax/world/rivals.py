@@ -22,8 +22,8 @@ from __future__ import annotations
 import itertools
 
 from vccjax.errors import ProgramSyntaxError
-from vccjax.instructions import NAMES, OP
-from vccjax.program import Program, check_loop_syntax
+from vccjax.machine.instructions import NAMES, OP
+from vccjax.machine.program import Program, check_loop_syntax
 
 Rival = tuple[str, Program]  # (what was changed, the program)
 

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from vccjax.config import DEFAULT_CONFIG
+from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import SceneError
-from vccjax.generate import random_scene
-from vccjax.perception import parse_image
-from vccjax.render import render
+from vccjax.world.scenes import random_scene
+from vccjax.vision.perception import parse_image
+from vccjax.vision.render import render
 
 
 def _match(true, found, tau):
@@ -70,10 +70,10 @@ def evaluate(n: int, style: str, seed: int = 0, size: int = 384, progress: bool 
 
 def _concept_end_to_end(job: tuple[str, str, str, int, int]) -> tuple[str, int, list[int]]:
     """One concept: (name, pairs checked, indices of the test pairs that disagree)."""
-    from vccjax.concepts import concept_names, reference_program
-    from vccjax.dataset import Dataset
-    from vccjax.reference import RefMachine
-    from vccjax.scene import scenes_match
+    from vccjax.world.concepts import concept_names, reference_program
+    from vccjax.world.dataset import Dataset
+    from vccjax.machine.reference import RefMachine
+    from vccjax.machine.scene import scenes_match
 
     folder, name, style, pairs, size = job
     ci = concept_names().index(name)  # render seeds depend on the concept, not on the subset run
@@ -106,7 +106,7 @@ def end_to_end(
 
     from tqdm import tqdm
 
-    from vccjax.dataset import Dataset
+    from vccjax.world.dataset import Dataset
 
     names = concepts or Dataset(folder).concepts
     jobs = [(str(folder), n, style, pairs, size) for n in names]

@@ -18,12 +18,12 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from vccjax.geometry import imagined_pixels
-from vccjax.instructions import COLORS, SHAPES
-from vccjax.reference import RefMachine
-from vccjax.render import render
-from vccjax.scene import Scene
-from vccjax.trace import Frame
+from vccjax.machine.geometry import imagined_pixels
+from vccjax.machine.instructions import COLORS, SHAPES
+from vccjax.machine.reference import RefMachine
+from vccjax.vision.render import render
+from vccjax.machine.scene import Scene
+from vccjax.views.trace import Frame
 
 HEADER, FOOTER, MARGIN = 34, 48, 6
 FONT = cv2.FONT_HERSHEY_SIMPLEX

@@ -23,13 +23,13 @@ from pathlib import Path
 
 import numpy as np
 
-from vccjax.concepts import concept_names, reference_program
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.world.concepts import concept_names, reference_program
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import DataFileError, read_json
-from vccjax.examples import TEST, TRAIN, TRAIN_WIDE, WIDE_PATIENCE, ExampleError, discriminate, make_pairs
-from vccjax.instructions import COLORS, SHAPES
-from vccjax.rivals import rival_programs
-from vccjax.scene import Scene, SceneObject
+from vccjax.world.pairs import TEST, TRAIN, TRAIN_WIDE, WIDE_PATIENCE, ExampleError, discriminate, make_pairs
+from vccjax.machine.instructions import COLORS, SHAPES
+from vccjax.world.rivals import rival_programs
+from vccjax.machine.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
 VERSION = 8  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
@@ -217,7 +217,7 @@ def shipped_folder() -> Path:
     sample and compares hashes), so that induction needs no hour-long build first."""
     from importlib import resources
 
-    return Path(str(resources.files("vccjax").joinpath("data/examples")))
+    return Path(str(resources.files("vccjax.world").joinpath("data/examples")))
 
 
 def dataset_for(concepts: Iterable[str], seed: int, folder: str | Path | None, progress: bool = True) -> Dataset:
@@ -290,17 +290,3 @@ class Dataset:
         ins = arrays_to_scenes(a[f"{split}_in"], a[f"{split}_in_pointer"])
         outs = arrays_to_scenes(a[f"{split}_out"], a[f"{split}_out_pointer"])
         return list(zip(ins, outs))
-
-    def image_pairs(
-        self, concept: str, split: str = "train", style: str = "schematic", size: int = 384,
-        seed: int = 0,
-    ) -> list[tuple[np.ndarray, np.ndarray]]:
-        """The concept's pairs as RGB images (rendered on demand, seeded per pair: the same
-        arguments give the same pixels; input and output of a pair share a style draw)."""
-        from vccjax.render import render
-
-        out = []
-        for k, (a, b) in enumerate(self.pairs(concept, split)):
-            s = int(np.random.default_rng([seed, k]).integers(2**31))
-            out.append((render(a, size, style, seed=s), render(b, size, style, seed=s)))
-        return out

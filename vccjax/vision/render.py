@@ -4,7 +4,7 @@
 - varied: seeded background (flat tint, gradient or texture), lighting gradient,
   per-object shading and colour jitter, dark outlines, noise and a slight blur.
 
-Shapes are drawn from the same geometry as the machine's masks (spec section 1), at
+Shapes are drawn from the same geometry as the machine's masks (docs/vcc.md section 1), at
 the image's own resolution with 4x supersampling on the edges. The pointer is a
 black-ringed white cross-hair dot. Imagined objects are never drawn.
 """
@@ -16,8 +16,8 @@ import math
 import cv2
 import numpy as np
 
-from vccjax.geometry import _star_polygon
-from vccjax.scene import Scene
+from vccjax.machine.geometry import shape_polygon
+from vccjax.machine.scene import Scene
 
 # Flat RGB colours of the schematic style; perception classifies by hue.
 PALETTE = {
@@ -29,24 +29,6 @@ PALETTE = {
 BACKGROUND = (255, 255, 255)
 STYLES = ("schematic", "varied")
 _SS = 4  # supersampling for anti-aliased edges
-
-
-def shape_polygon(shape: str, x: float, y: float, w: float, px: float) -> np.ndarray | None:
-    """Outline in image pixels (None for a circle)."""
-    h = w / 2
-    if shape == "square":
-        pts = [(-h, -h), (h, -h), (h, h), (-h, h)]
-    elif shape == "diamond":
-        pts = [(0, -h), (h, 0), (0, h), (-h, 0)]
-    elif shape == "triangle":
-        pts = [(0, -h), (h, h), (-h, h)]
-    elif shape == "star":
-        pts = [tuple(p) for p in _star_polygon(h)]
-    elif shape == "circle":
-        return None
-    else:
-        raise ValueError(f"unknown shape {shape!r}")
-    return np.array([((x + dx) * px, (y + dy) * px) for dx, dy in pts], np.float64)
 
 
 def _draw_shape(canvas: np.ndarray, shape: str, x: float, y: float, w: float, color, size: int,
@@ -152,3 +134,13 @@ def _render_varied(scene: Scene, size: int, rng: np.random.Generator) -> np.ndar
     img = np.clip(img, 0, 255).astype(np.uint8)
     sigma = rng.uniform(0.3, 0.8)
     return cv2.GaussianBlur(img, (0, 0), sigma)
+
+
+def render_pairs(pairs, style: str = "schematic", size: int = 384, seed: int = 0) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Example pairs as RGB images, seeded per pair (the same arguments give the same
+    pixels; input and output of a pair share a style draw)."""
+    out = []
+    for k, (a, b) in enumerate(pairs):
+        s = int(np.random.default_rng([seed, k]).integers(2**31))
+        out.append((render(a, size, style, seed=s), render(b, size, style, seed=s)))
+    return out

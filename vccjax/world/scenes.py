@@ -5,15 +5,13 @@ The tabletop-world dataset builds on this with per-concept rules.
 
 from __future__ import annotations
 
-import cv2
 import numpy as np
 
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import SceneError
-from vccjax.geometry import object_pixels
-from vccjax.instructions import COLORS, SHAPES
-from vccjax.render import shape_polygon
-from vccjax.scene import Scene, SceneObject, box_inside, to_units
+from vccjax.machine.geometry import object_pixels, shape_polygon
+from vccjax.machine.instructions import COLORS, SHAPES
+from vccjax.machine.scene import Scene, SceneObject, box_inside, to_units
 
 
 _FINE = 8  # subdivisions per raster pixel when finding what a drawn shape covers
@@ -24,6 +22,8 @@ def drawn_cover(shape: str, width: float, x: float, y: float, cfg: VCCConfig = D
     machine's mask, whose pixels are those with their *centre* inside. A star's thin tips
     cross pixels whose centres lie outside it, so masks alone under-state how close two
     drawn shapes come."""
+    import cv2  # only scene generation rasterises drawn outlines; the machine never does
+
     r = cfg.raster
     reach = int(np.ceil(width / 2 * r)) + 2
     qx, qy = int(x * r), int(y * r)
@@ -49,6 +49,19 @@ def drawn_cover(shape: str, width: float, x: float, y: float, cfg: VCCConfig = D
     touched[pix[:, 1] - qy + reach, pix[:, 0] - qx + reach] = 1
     rows, cols = np.nonzero(touched)
     return rows + qy - reach, cols + qx - reach
+
+def _grow(mask: np.ndarray, g: int) -> np.ndarray:
+    """A boolean mask dilated by a (2g+1) x (2g+1) square: every pixel within g in both
+    directions of a set pixel (a binary max filter; outside the raster counts as empty)."""
+    p = np.pad(mask, g)
+    rows = np.zeros((p.shape[0], mask.shape[1]), bool)
+    for d in range(2 * g + 1):
+        rows |= p[:, d : d + mask.shape[1]]
+    out = np.zeros(mask.shape, bool)
+    for d in range(2 * g + 1):
+        out |= rows[d : d + mask.shape[0]]
+    return out
+
 
 def random_scene(
     rng: np.random.Generator,
@@ -97,7 +110,7 @@ def random_scene(
             covered[rows, cols] = True
             mask = np.zeros((r, r), np.uint8)
             mask[rows, cols] = 1
-            blocked |= cv2.dilate(mask, np.ones((2 * gap + 1, 2 * gap + 1), np.uint8)) > 0
+            blocked |= _grow(mask > 0, gap)
             break
         else:
             raise SceneError(f"could not place object {len(objs)} in {max_tries} tries")
@@ -113,101 +126,3 @@ def random_scene(
         else:
             raise SceneError(f"could not place the pointer clear of objects in {max_tries} tries")
     return Scene(tuple(objs), ptr)
-
-
-def _bigram_table() -> np.ndarray:
-    """Order-1 instruction transition counts of the reference programs (start = row N_OPS,
-    end = column N_OPS), with a small floor so that every transition is possible."""
-    from vccjax.concepts import all_concepts
-    from vccjax.instructions import N_OPS
-
-    table = np.full((N_OPS + 1, N_OPS + 1), 1e-3)
-    for program in all_concepts().values():
-        prev = N_OPS
-        for op in program.ops:
-            table[prev, op] += 1
-            prev = op
-        table[prev, N_OPS] += 1
-    return table / table.sum(axis=1, keepdims=True)
-
-
-_BIGRAMS: np.ndarray | None = None
-
-
-def _next_op(rng: np.random.Generator, prev: int, noise: float) -> int:
-    global _BIGRAMS
-    from vccjax.instructions import N_OPS
-
-    if _BIGRAMS is None:
-        _BIGRAMS = _bigram_table()
-    p = (1 - noise) * _BIGRAMS[prev] + noise / (N_OPS + 1)
-    return int(rng.choice(N_OPS + 1, p=p))
-
-
-def _random_arg(rng: np.random.Generator, op: int) -> int:
-    from vccjax.instructions import NAMES, arg_domain
-
-    dom = arg_domain(NAMES[op])
-    return int(rng.integers(len(dom))) if dom else 0
-
-
-def random_program(rng: np.random.Generator, max_len: int = 24, noise: float = 0.15):
-    """A random (often failing) program: a walk on the reference programs' instruction
-    bigrams mixed with uniform noise, random arguments, loops included."""
-    from vccjax.instructions import N_OPS
-    from vccjax.program import Program
-
-    ops: list[int] = []
-    prev = N_OPS
-    while len(ops) < max_len:
-        op = _next_op(rng, prev, noise)
-        if op == N_OPS:
-            if ops:
-                break
-            continue
-        ops.append(op)
-        prev = op
-    return Program(tuple(ops), tuple(_random_arg(rng, o) for o in ops))
-
-
-def random_deep_program(
-    rng: np.random.Generator, scene: Scene, max_len: int = 24, noise: float = 0.2,
-    p_fail: float = 0.03, cfg: VCCConfig = DEFAULT_CONFIG,
-):
-    """A random program that mostly runs on `scene`: each instruction is redrawn (a few
-    times) when the reference machine says it fails, so programs reach deep states;
-    with probability p_fail a failing instruction is kept and ends the program."""
-    import copy
-
-    from vccjax.instructions import N_OPS
-    from vccjax.program import Program
-    from vccjax.reference import RefMachine
-
-    machine = RefMachine(scene, cfg, validate=False)
-    ops: list[int] = []
-    args: list[int] = []
-    prev = N_OPS
-    while len(ops) < max_len:
-        for attempt in range(8):
-            op = _next_op(rng, prev, noise)
-            if op == N_OPS and rng.random() < 0.75:  # keep going: long programs reach deep states
-                continue
-            if op == N_OPS:
-                break
-            arg = _random_arg(rng, op)
-            trial = copy.deepcopy(machine)
-            trial.step(op, arg)
-            if not trial.failed or attempt == 7 or rng.random() < p_fail:
-                break
-        else:
-            op = N_OPS
-        if op == N_OPS:
-            if ops:
-                break
-            continue
-        ops.append(op)
-        args.append(arg)
-        machine, prev = trial, op
-        if machine.failed:
-            break
-    return Program(tuple(ops), tuple(args))

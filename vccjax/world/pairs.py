@@ -22,13 +22,13 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import SceneError
-from vccjax.generate import random_scene
-from vccjax.instructions import NAMES
-from vccjax.program import Program
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene, scenes_match
+from vccjax.world.scenes import random_scene
+from vccjax.machine.instructions import NAMES
+from vccjax.machine.program import Program
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, scenes_match
 
 POINTER_OPS = frozenset({"fixate_pointer", "move_hand_to_pointer", "attend_pointer"})
 

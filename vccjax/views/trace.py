@@ -3,18 +3,18 @@
 The reference interpreter calls a watcher after every instruction it executes, loop
 iterations included (the body's instructions again, each time round), so a trace shows
 what actually ran, in order, and where it failed. Each frame keeps a copy of the
-machine; `vccjax.viewer` draws them.
+machine; `vccjax.views.viewer` draws them.
 """
 
 from __future__ import annotations
 
 import dataclasses
 
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.instructions import NAMES, arg_domain
-from vccjax.program import Program
-from vccjax.reference import RefMachine
-from vccjax.scene import Scene
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.instructions import NAMES, arg_domain
+from vccjax.machine.program import Program
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene
 
 
 @dataclasses.dataclass(frozen=True)

@@ -12,9 +12,9 @@ import dataclasses
 
 import numpy as np
 
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.geometry import imagined_pixels, object_pixels
-from vccjax.instructions import (
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.geometry import imagined_pixels, object_pixels
+from vccjax.machine.instructions import (
     COLORS,
     FIXATE_TARGETS,
     FORBIDDEN_IN_LOOP,
@@ -22,8 +22,8 @@ from vccjax.instructions import (
     REQUIRED_IN_LOOP,
     SHAPES,
 )
-from vccjax.program import Program
-from vccjax.scene import Scene, SceneObject, box_inside, to_units
+from vccjax.machine.program import Program
+from vccjax.machine.scene import Scene, SceneObject, box_inside, to_units
 
 
 @dataclasses.dataclass
@@ -72,7 +72,7 @@ class RefMachine:
         self.in_loop = False
         self.loop_active = False
         self.body: list[tuple[int, int, int]] = []  # (op, arg, program index)
-        self.watch = None  # called as watch(machine, op, arg, pc) after each instruction (vccjax.trace)
+        self.watch = None  # called as watch(machine, op, arg, pc) after each instruction (vccjax.views.trace)
 
     def clone(self) -> RefMachine:
         """An independent copy (the scene, read-only, is shared): a search keeps one per prefix."""

@@ -15,10 +15,10 @@ import jax.numpy as jnp
 import numpy as np
 from flax import struct
 
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.instructions import COLORS, SHAPES
-from vccjax.scene import Scene
-from vccjax.state import SceneConst, VCCState, centres
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.instructions import COLORS, SHAPES
+from vccjax.machine.scene import Scene
+from vccjax.machine.state import SceneConst, VCCState, centres
 
 NO, YES, ASK = 0, 1, 2
 

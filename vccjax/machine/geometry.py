@@ -14,13 +14,14 @@ import math
 
 import numpy as np
 
-from vccjax.config import VCCConfig
-from vccjax.instructions import SHAPES
+from vccjax.machine.config import VCCConfig
+from vccjax.machine.instructions import SHAPES
 
 _STAR_INNER = math.sin(math.radians(18)) / math.sin(math.radians(54))
 
 
-def _star_polygon(r_out: float) -> np.ndarray:
+def star_polygon(r_out: float) -> np.ndarray:
+    """The 10 vertices of a five-pointed star of outer radius r_out, first point up."""
     angles = np.radians(-90.0 + 36.0 * np.arange(10))
     radii = np.where(np.arange(10) % 2 == 0, r_out, r_out * _STAR_INNER)
     return np.stack([radii * np.cos(angles), radii * np.sin(angles)], axis=1)
@@ -38,7 +39,7 @@ def _inside(shape: str, dx: np.ndarray, dy: np.ndarray, w: float) -> np.ndarray:
     if shape == "triangle":  # apex up at -h, base at +h, base width w
         return (dy >= -h) & (dy <= h) & (np.abs(dx) <= (dy + h) / 2.0)
     if shape == "star":  # even-odd rule on the 10-vertex outline
-        poly = _star_polygon(h)
+        poly = star_polygon(h)
         inside = np.zeros(dx.shape, bool)
         for k in range(10):
             (x0, y0), (x1, y1) = poly[k], poly[(k + 1) % 10]
@@ -120,3 +121,22 @@ def imagined_pixels(kind: int, fx: int, fy: int, cfg: VCCConfig):
         raise ValueError(f"unknown imagined kind {kind}")
     rows, cols = np.nonzero(inside)
     return rows.astype(np.int32), cols.astype(np.int32)
+
+
+def shape_polygon(shape: str, x: float, y: float, w: float, px: float) -> np.ndarray | None:
+    """A drawn shape's outline, scaled by `px` pixels per workspace unit (None for a
+    circle). Images and the scene generator draw shapes from it."""
+    h = w / 2
+    if shape == "square":
+        pts = [(-h, -h), (h, -h), (h, h), (-h, h)]
+    elif shape == "diamond":
+        pts = [(0, -h), (h, 0), (0, h), (-h, 0)]
+    elif shape == "triangle":
+        pts = [(0, -h), (h, h), (-h, h)]
+    elif shape == "star":
+        pts = [tuple(p) for p in star_polygon(h)]
+    elif shape == "circle":
+        return None
+    else:
+        raise ValueError(f"unknown shape {shape!r}")
+    return np.array([((x + dx) * px, (y + dy) * px) for dx, dy in pts], np.float64)

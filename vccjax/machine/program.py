@@ -9,7 +9,7 @@ from collections.abc import Iterable, Mapping, Sequence
 import numpy as np
 
 from vccjax.errors import ProgramSyntaxError
-from vccjax.instructions import (
+from vccjax.machine.instructions import (
     FORBIDDEN_IN_LOOP,
     NAMES,
     OP,

@@ -16,11 +16,11 @@ import dataclasses
 import cv2
 import numpy as np
 
-from vccjax.config import DEFAULT_CONFIG
+from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import SceneError
-from vccjax.instructions import SHAPES
-from vccjax.render import shape_polygon
-from vccjax.scene import Scene, SceneObject, to_units
+from vccjax.machine.instructions import SHAPES
+from vccjax.machine.geometry import shape_polygon
+from vccjax.machine.scene import Scene, SceneObject, to_units
 
 # OpenCV hue (0..180) bands of the four colours; anything saturated outside them is unknown.
 HUE_BANDS = {"red": ((0, 10), (165, 180)), "yellow": ((18, 38),), "green": ((45, 88),), "blue": ((95, 135),)}

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from vccjax.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import SceneError, read_json
-from vccjax.geometry import object_pixels
-from vccjax.instructions import COLORS, SHAPES
+from vccjax.machine.geometry import object_pixels
+from vccjax.machine.instructions import COLORS, SHAPES
 
 
 @dataclasses.dataclass(frozen=True)

@@ -1,0 +1,98 @@
+"""The search's batched stepping: many programs of many concepts, each on its concept's
+example scenes, stepped by one static instruction per device call.
+
+A search holds (B, E) states, B programs times E examples; `step_examples` steps them
+all by one op. Loops: with replay=False a `loop_end` only closes the loop and the
+caller replays its body one static instruction at a time (`loop_needs_iteration`,
+`replay_examples`), instead of tracing every instruction's code in a loop.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import jax
+import jax.numpy as jnp
+
+from vccjax.machine.config import VCCConfig
+from vccjax.machine.instructions import OP
+from vccjax.machine.ops import hand_to_attended, select
+from vccjax.machine.state import SceneConst, VCCState
+from vccjax.machine.step import execute, step_op
+
+
+def _fails_empty_handed(cfg, c, s, arg):
+    return s, jnp.bool_(True)
+
+
+# Carrying is the costly part of a hand move, and it only happens with an object held:
+# when no state in a batch holds one, these ops run a stand-in with the same outcome.
+EMPTY_HANDED = {
+    OP["move_hand_to_attended_object"]: functools.partial(hand_to_attended, carry=False),
+    **{OP[f"move_hand_{d}"]: _fails_empty_handed for d in ("left", "right", "up", "down")},
+    OP["move_hand_to_pointer"]: _fails_empty_handed,
+    OP["move_hand_to_fixate_collision"]: _fails_empty_handed,
+}
+
+
+def _batched(cfg: VCCConfig, op: int, make, first, states, *rest):
+    """`make(fn)` builds the batched step `(first, states, *rest) -> states` with `fn`
+    standing in for the op's function; a carry op pays for the carry only when some
+    state in the batch holds an object."""
+    if op not in EMPTY_HANDED:
+        return make(None)(first, states, *rest)
+    return jax.lax.cond(jnp.any(states.held >= 0), make(None), make(EMPTY_HANDED[op]), first, states, *rest)
+
+
+def _per_task(consts: SceneConst, one, example_axes: tuple):
+    """Rows of (B, E) states, each row a program of the task `tasks[row]`; `one` steps one
+    (scene, state, ...) pair. The task's scenes are read by index, not copied per row."""
+
+    def row(task, s, *rest):
+        c = jax.tree.map(lambda a: a[task], consts)
+        return jax.vmap(one, in_axes=(0, 0) + example_axes)(c, s, *rest)
+
+    return jax.vmap(row)
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1, 6))
+def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Array, states: VCCState,
+                  args: jax.Array, replay: bool = True) -> VCCState:
+    """Step B programs' states on their tasks' E examples by one static op.
+
+    consts: (K, E, ...) the examples' scenes of K tasks (concepts); tasks: (B,) which task
+    each program belongs to; states: (B, E, ...); args: (B,). Programs of many concepts
+    step in one call, so a search over many concepts makes large batches. With
+    replay=False a `loop_end` only closes the loop: the caller replays the body
+    with `loop_needs_iteration` and `replay_examples` (one static op at a time, instead
+    of every instruction's code in a traced loop)."""
+
+    def per_program(fn):
+        def one(c, s, arg):
+            return step_op(cfg, c, s, op, arg, fn=fn, replay=replay)
+
+        return _per_task(consts, one, (None,))
+
+    return _batched(cfg, op, per_program, tasks, states, args)
+
+
+def loop_needs_iteration(cfg: VCCConfig, s: VCCState, iteration) -> jax.Array:
+    """Whether a just-closed loop runs another iteration (`iteration` = iterations done;
+    docs/vcc.md section 5: while k < len(A), at most n_max in all, the first ran eagerly)."""
+    return s.loop_active & ~s.failed & (iteration < cfg.n_max) & (s.cursor < s.attn_len)
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1))
+def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Array, states: VCCState,
+                    args: jax.Array, pcs: jax.Array, active: jax.Array) -> VCCState:
+    """One body instruction of a replayed loop, static op, for states where `active`
+    (B, E); the others are returned unchanged. consts, tasks as in `step_examples`;
+    args, pcs: (B,)."""
+
+    def per_program(fn):
+        def one(c, s, arg, pc, act):
+            return select(act & ~s.failed, execute(cfg, c, s, op, arg, pc, fn), s)
+
+        return _per_task(consts, one, (None, None, 0))
+
+    return _batched(cfg, op, per_program, tasks, states, args, pcs, active)

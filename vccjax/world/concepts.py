@@ -1,0 +1,72 @@
+"""The 546 benchmark concepts and their reference programs (MIT-licensed data, see the file)."""
+
+from __future__ import annotations
+
+import functools
+import json
+from importlib import resources
+
+from vccjax.errors import DataFileError, ProgramSyntaxError
+from vccjax.machine.instructions import REFERENCE_IDS
+from vccjax.machine.program import Program, check_loop_syntax
+
+LICENSE = "MIT License, Copyright (c) 2017 Vicarious FPC Inc"
+
+
+@functools.lru_cache(maxsize=1)
+def _raw() -> dict:
+    text = resources.files("vccjax.world").joinpath("data/concepts.json").read_text()
+    d = json.loads(text)
+    if d.get("license") != LICENSE or not isinstance(d.get("concepts"), dict):
+        raise DataFileError("vccjax/world/data/concepts.json: not the benchmark concept file")
+    if d.get("reference_instruction_ids") != REFERENCE_IDS:
+        raise DataFileError("vccjax/world/data/concepts.json: instruction ids differ from the spec's table")
+    return d
+
+
+def concept_names() -> list[str]:
+    """All concept names, in the file's order."""
+    return list(_raw()["concepts"])
+
+
+@functools.lru_cache(maxsize=None)
+def reference_program(name: str) -> Program:
+    """The reference program that defines a concept."""
+    concepts = _raw()["concepts"]
+    if name not in concepts:
+        close = [c for c in concepts if name.lower() in c.lower()][:5]
+        hint = f"; did you mean {', '.join(close)}?" if close else ""
+        raise KeyError(f"unknown concept {name!r}{hint}")
+    try:
+        program = Program.from_steps(concepts[name])
+        check_loop_syntax(program)
+    except ProgramSyntaxError as e:
+        raise DataFileError(f"concept {name}: {e}") from None
+    return program
+
+
+def all_concepts() -> dict[str, Program]:
+    return {name: reference_program(name) for name in concept_names()}
+
+
+DEMO: tuple[str, ...] = (  # a dozen short concepts: `--concepts demo` (all found in under a minute on 2 cores)
+    "change_target_obj_to_given_color", "change_target_position_to_given_color", "remove_bottom_obj",
+    "remove_given_target_color_objs", "remove_given_target_shape_objs", "remove_left_most_obj",
+    "remove_right_most_obj", "remove_top_obj", "remove_given_target_shape_and_color_combo_objs",
+    "move_to_bottom_edge", "move_to_right_edge", "move_to_top_edge")
+
+
+def concept_list(spec: str) -> list[str]:
+    """Concepts named on a command line: 'all', 'demo' or a comma-separated list."""
+    names = concept_names()
+    if spec == "all":
+        return names
+    if spec == "demo":
+        return list(DEMO)
+    chosen = list(dict.fromkeys(c.strip() for c in spec.split(",") if c.strip()))  # once each, in order
+    if not chosen:
+        raise ValueError(f"--concepts {spec!r}: names no concept ('all', 'demo' or a comma-separated list)")
+    unknown = [c for c in chosen if c not in names]
+    if unknown:
+        raise ValueError(f"unknown concept(s): {', '.join(unknown)} (see `vcc concepts`)")
+    return chosen
