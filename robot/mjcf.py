@@ -6,7 +6,7 @@ One model serves every scenario, so that one compiled MJX rollout serves them al
 a scenario differs only in state (which slots stand on the table and where, the
 pointer's and distractors' mocap positions) and in what only the camera sees (colours,
 table texture). Physics settings follow measured facts on this CPU
-(`../shared/notes/mjx-on-cpu.md`): 5 ms Newton steps, 5 iterations, pyramidal cones,
+(docs/robot.md, "MJX on CPU"): 5 ms Newton steps, 5 iterations, pyramidal cones,
 contacts only between pads, objects and the table.
 """
 

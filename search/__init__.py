@@ -1,1 +1,3 @@
-"""Program induction (explore-compress over the JAX emulator). Not built yet: see issue 4."""
+"""Program induction: explore-compress. An order-1 Markov model over instructions (with
+learned subroutines) guides a pruned depth-first search run on the VCC; compression
+refits the model on what was found. See docs/search.md."""

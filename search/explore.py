@@ -5,7 +5,7 @@ frame holds up to `chunk` live prefixes with their emulator states on all exampl
 its children (prefix + one portion) are made in slices, grouped by instruction, and
 stepped with `step_examples`, so every group runs one instruction's code over
 (programs x examples) at once. A child that fails on any example is dropped with its
-whole subtree (spec section 3). A child that may end is a complete program: it is
+whole subtree (docs/vcc.md section 3). A child that may end is a complete program: it is
 checked against every example's output on device (YES / NO, and ASK settled on the
 host). The search runs to the end of the tree (paper: DFS to completion) but, once a
 program is found, only cheaper ones can replace it, so the cutoff drops to just below

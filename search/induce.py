@@ -111,7 +111,7 @@ def fit_model(programs: Sequence[Program], settings: Settings, with_subroutines:
 
 
 def generalization(program: Program, pairs: Sequence[tuple[Scene, Scene]], tau: float) -> int:
-    """How many pairs the program gets right (spec section 7)."""
+    """How many pairs the program gets right (docs/vcc.md section 7)."""
     good = 0
     for a, b in pairs:
         m = RefMachine(a).run(program)

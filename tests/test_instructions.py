@@ -1,4 +1,4 @@
-"""Every instruction of spec section 3: its effect and each of its failure rules.
+"""Every instruction of docs/vcc.md section 3: its effect and each of its failure rules.
 
 Each test runs its program with `run_both`, so it also checks that the JAX emulator
 and the reference interpreter agree on the whole machine state; the assertions are

@@ -32,7 +32,7 @@ class VCCConfig:
         if self.raster < 16 or self.raster > 512:
             raise ValueError(f"raster must be in [16, 512] (int32 geometry), got {self.raster}")
         if self.n_max < 10:
-            raise ValueError(f"n_max must be at least 10 (spec section 1), got {self.n_max}")
+            raise ValueError(f"n_max must be at least 10 (docs/vcc.md section 1), got {self.n_max}")
         if not 0.0 < self.max_width <= 0.5:
             raise ValueError(f"max_width must be in (0, 0.5], got {self.max_width}")
 
@@ -53,7 +53,7 @@ class VCCConfig:
 
     @property
     def tau(self) -> float:
-        """Center tolerance for comparing scenes (spec section 7)."""
+        """Center tolerance for comparing scenes (docs/vcc.md section 7)."""
         return max(0.02, 1.5 / self.raster)
 
 

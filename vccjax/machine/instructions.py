@@ -7,7 +7,7 @@ COLORS: tuple[str, ...] = ("red", "green", "blue", "yellow")
 FIXATE_TARGETS: tuple[str, ...] = ("left", "right", "top", "bottom", "center")
 IMAGINE_KINDS: tuple[str, ...] = ("circle", "hline")
 
-# Reference instruction ids of the paper's code (spec section 3); 15 and 24 are unused.
+# Reference instruction ids of the paper's code (docs/vcc.md section 3); 15 and 24 are unused.
 REFERENCE_IDS: dict[str, int] = {
     "scene_parse": 0,
     "top_down_attend": 1,
@@ -57,7 +57,7 @@ def arg_domain(name: str) -> tuple[str, ...]:
     return ARG_DOMAINS.get(name, ())
 
 
-# Instructions that may not appear inside a loop body (spec section 5).
+# Instructions that may not appear inside a loop body (docs/vcc.md section 5).
 FORBIDDEN_IN_LOOP: frozenset[str] = frozenset(
     {"set_shape_attn", "set_color_attn", "reset_attn", "loop_start"}
 )

@@ -67,7 +67,7 @@ def _attended_centre(cfg, c, s):
     return centres(c, s, cfg)[jnp.maximum(s.attended, 0)]
 
 
-# ---- instructions (spec section 3, in the order of its table) -------------------------
+# ---- instructions (docs/vcc.md section 3, in the order of its table) -------------------------
 def op_scene_parse(cfg, c, s, arg):
     n = cfg.n_max
     return s.replace(

@@ -167,7 +167,7 @@ def parse(
     check_loops: bool = True,
     body_max: int | None = None,
 ) -> Program:
-    """Parse the text form of spec section 6 (';' or newline separated, `name` or `name(arg)`).
+    """Parse the text form of docs/vcc.md section 6 (';' or newline separated, `name` or `name(arg)`).
 
     Lines starting with '#' are comments. Errors name the instruction's position.
     """
@@ -196,7 +196,7 @@ def parse(
 
 
 def check_loop_syntax(program: Program, *, complete: bool = True, body_max: int | None = None) -> None:
-    """Raise ProgramSyntaxError for loop-structure errors (spec section 5).
+    """Raise ProgramSyntaxError for loop-structure errors (docs/vcc.md section 5).
 
     With complete=False an open loop at the end is allowed (a search prefix).
     """

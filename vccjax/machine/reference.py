@@ -1,8 +1,8 @@
 """The scalar reference interpreter: plain Python/NumPy, written to be read.
 
 It is the oracle the JAX emulator is tested against and the baseline of the
-benchmarks. Every rule of spec sections 2-5 appears here once, in the order of
-the spec's table; `docs/vcc.md` records the choices the spec leaves open.
+benchmarks. Every rule of docs/vcc.md sections 2-5 appears here once, in the order of
+the instruction table of section 3.
 """
 
 from __future__ import annotations
@@ -92,7 +92,7 @@ class RefMachine:
         return self
 
     def step(self, op: int, arg: int = 0) -> None:
-        """Take the next program instruction (with the loop bookkeeping of spec section 5)."""
+        """Take the next program instruction (with the loop bookkeeping of docs/vcc.md section 5)."""
         if self.failed:
             return
         pc = self.pc
@@ -233,7 +233,7 @@ class RefMachine:
         self.need_held()
         self.carry([(t * ux, t * uy) for t in range(self.cfg.raster + 1)])
 
-    # ---- instructions (spec section 3) ----------------------------------------------
+    # ---- instructions (docs/vcc.md section 3) ----------------------------------------------
     def op_scene_parse(self, arg: int) -> None:
         if self.parsed:
             raise Failure("scene_parse is not first")

@@ -1,4 +1,4 @@
-"""Perception accuracy on rendered scenes: the figures issue 3 asks for.
+"""Perception accuracy on rendered scenes, and end to end through the machine.
 
 For each seeded scene (2 to 8 objects, widths 0.04 to 0.20, a pointer half the time):
 render it, parse it, and match parsed objects to true ones (same shape and colour,

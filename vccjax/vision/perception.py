@@ -3,7 +3,7 @@
 Objects are the saturated regions (table, pointer and outlines are not saturated).
 Each colour class is segmented on its own hue band, so that touching objects of
 different colours stay apart. A region's shape is the one whose ideal rendering, placed
-by the region's box and the shape's geometry (spec section 1), overlaps it best
+by the region's box and the shape's geometry (docs/vcc.md section 1), overlaps it best
 (analysis by synthesis; robust down to objects ten pixels wide). The pointer is a dark ring, away from any
 object. An image with no objects, or with an object of a colour outside the four,
 raises SceneError naming what was found and where.

@@ -20,7 +20,7 @@ def _raw() -> dict:
     if d.get("license") != LICENSE or not isinstance(d.get("concepts"), dict):
         raise DataFileError("vccjax/world/data/concepts.json: not the benchmark concept file")
     if d.get("reference_instruction_ids") != REFERENCE_IDS:
-        raise DataFileError("vccjax/world/data/concepts.json: instruction ids differ from the spec's table")
+        raise DataFileError("vccjax/world/data/concepts.json: instruction ids differ from docs/vcc.md section 3")
     return d
 
 

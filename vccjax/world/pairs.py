@@ -1,4 +1,4 @@
-"""Example pairs for a concept: run its reference program on generated scenes (spec section 8).
+"""Example pairs for a concept: run its reference program on generated scenes (docs/vcc.md section 8).
 
 A generated input is kept only if the program does not fail on it and changes it
 (the output does not match the input within tau); outputs stay inside the workspace
