@@ -3,10 +3,59 @@
 from __future__ import annotations
 
 import argparse
+import datetime
 import json
+import math
+import shlex
+import subprocess
 from pathlib import Path
 
 DEFAULT_DATA = Path.home() / ".cache" / "vccjax" / "argpred-data"
+
+
+def _require(ok: bool, option: str, want: str, value) -> None:
+    """Refuse a bad option before anything is drawn, trained or written."""
+    if not ok:
+        raise ValueError(f"{option} must be {want}, got {value!r}")
+
+
+def _share(option: str, value: float) -> None:
+    _require(math.isfinite(value) and 0 <= value <= 1, option, "a share from 0 to 1", value)
+
+
+def _write_json(path: Path, data: dict) -> None:
+    """`path`, replaced whole: a failed write leaves no cut file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_text(json.dumps(data, indent=1) + "\n")
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _now() -> str:
+    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+
+
+def _commit() -> str | None:
+    try:
+        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                              cwd=Path(__file__).parent, timeout=10).stdout.strip() or None
+    except (OSError, subprocess.SubprocessError):
+        return None
+
+
+def _eval_command(weights: str | None = None, concepts: str = "all", dataset: str | None = None,
+                  out: str | None = None, record: bool = False) -> str:
+    """The `vcc argpred eval` command line that measures this (options left at their
+    defaults are left out)."""
+    parts = ["vcc", "argpred", "eval"]
+    for flag, value, default in (("--weights", weights, None), ("--concepts", concepts, "all"),
+                                 ("--dataset", dataset, None), ("--out", out, None)):
+        if value != default:
+            parts += [flag, str(value)]
+    return shlex.join(parts + (["--record"] if record else []))
 
 
 def cmd_data(a: argparse.Namespace) -> int:
@@ -14,6 +63,9 @@ def cmd_data(a: argparse.Namespace) -> int:
 
     from argpred.data import build, built
 
+    _require(a.programs >= 1, "--programs", "at least 1", a.programs)
+    _share("--joined", a.joined)
+    _require(a.workers >= 0, "--workers", "0 (one per core) or more", a.workers)
     joined = 0.0 if a.kind == "carry" else a.joined
     m = build(a.out, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet,
               joined=joined, kind=a.kind)
@@ -28,9 +80,26 @@ def cmd_train(a: argparse.Namespace) -> int:
     import numpy as np
 
     from argpred import data as argdata
+    from argpred.recall import card_record, measure
     from argpred.train import TrainSettings, train_members
-    from argpred.weights import save
+    from argpred.weights import record, save
 
+    for option, value in (("--epochs", a.epochs), ("--batch", a.batch), ("--kernel", a.kernel), ("--depth", a.depth),
+                          ("--members", a.members)):
+        _require(value >= 1, option, "at least 1", value)
+    for option, value in (("--hidden", a.hidden), ("--carry", a.carry), ("--workers", a.workers)):
+        _require(value >= 0, option, "0 or more", value)
+    if a.programs is not None:
+        _require(a.programs >= 1, "--programs", "at least 1", a.programs)
+    if a.joined is not None:
+        _share("--joined", a.joined)
+    for option, value in (("--lr", a.lr), ("--positive-weight", a.positive_weight)):
+        _require(math.isfinite(value) and value > 0, option, "a positive number", value)
+    _require(math.isfinite(a.l1) and a.l1 >= 0, "--l1", "0 or a positive number", a.l1)
+    _require(math.isfinite(a.bias_start), "--bias-start", "a finite number", a.bias_start)
+    out = Path(a.out)
+    if out.is_dir():
+        raise ValueError(f"--out {out}: a folder; give the weights file to write")
     start = time.time()
     folders = [f for f in (a.data or "").split(",") if f]
     if len(folders) > 1:  # several built folders, trained on together (each verified, none redrawn)
@@ -56,7 +125,6 @@ def cmd_train(a: argparse.Namespace) -> int:
     settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, depth=a.depth, evidence=a.evidence,
                              bias_start=a.bias_start, epochs=a.epochs, batch=a.batch, learning_rate=a.lr, l1=a.l1,
                              positive_weight=a.positive_weight, seed=a.seed)
-    out = Path(a.out)
     model, params, histories = train_members(data, settings, a.members, checkpoint=out.with_suffix(".ckpt"),
                                              workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
     sha = save(out, model, params, {"settings": {k: getattr(settings, k) for k in settings.__dataclass_fields__},
@@ -69,25 +137,44 @@ def cmd_train(a: argparse.Namespace) -> int:
               f"train bce {last['train_bce']:.4f}, held-out bce {last.get('val_bce', float('nan')):.4f}, "
               f"held-out programs with every label right {last.get('val_all_labels_right', float('nan')):.3f}")
     print(f"{a.members} member(s) in {time.time() - start:.0f}s")
+    r, _ = measure(out)  # the card keeps the recall these weights were made with
+    record(out, recall=card_record(r, _now(), _eval_command(weights=str(out))))
+    print(f"concepts recalled: {r['recalled']} of {r['concepts']} (recall {r['recall']:.4f}; in the card)")
     print(f"weights: {out} (sha256 {sha})")
     return 0
 
 
 def cmd_recall(a: argparse.Namespace) -> int:
-    from argpred.predict import Predictor
-    from argpred.recall import recall
-    from vccjax.world.concepts import concept_names
-    from vccjax.world.dataset import dataset_for
+    import time
 
-    names = concept_names() if a.concepts == "all" else [c.strip() for c in a.concepts.split(",") if c.strip()]
-    ds = dataset_for(names, 0, a.dataset, progress=False)
-    r = recall(Predictor(a.weights), names, lambda c: ds.pairs(c, "train"))
-    if a.json:
-        Path(a.json).write_text(json.dumps(r, indent=1))
+    from argpred.recall import card_record, measure
+    from argpred.weights import record
+    from vccjax.world.concepts import concept_list
+
+    names = concept_list(a.concepts)
+    _require(a.show >= 0, "--show", "0 or more", a.show)
+    if a.record and (a.concepts != "all" or a.dataset):
+        raise ValueError("--record keeps the recall on all the concepts' shipped examples in the weights card: "
+                         "leave out --concepts and --dataset")
+    start = time.time()
+    r, card = measure(a.weights, names, a.dataset)
+    seconds = time.time() - start
+    date = _now()
+    if a.out:
+        _write_json(Path(a.out), {
+            "benchmark": "argpred-recall", "date": date, "commit": _commit(),
+            "command": _eval_command(a.weights, a.concepts, a.dataset, a.out, a.record),
+            "weights": a.weights or "shipped", "weights_sha256": card["sha256"],
+            "members": card["model"].get("members", 1), "dataset": a.dataset or "shipped", "split": "train",
+            "seconds": round(seconds, 2), **r})
+    if a.record:
+        record(a.weights, recall=card_record(r, date, _eval_command(a.weights)))
     for c, miss in list(r["missed"].items())[: a.show]:
         print(f"missed  {c}: " + "; ".join(f"{f}({', '.join(v)})" for f, v in miss.items()))
     print("mean extra arguments per function: "
           + ", ".join(f"{f} {v:.2f}" for f, v in r["mean_extra_arguments"].items()))
+    print(f"weights sha256 {card['sha256']}; {r['concepts']} concepts in {seconds:.1f} s"
+          + (f"; result: {a.out}" if a.out else "") + ("; recorded in the weights card" if a.record else ""))
     print(f"concepts recalled: {r['recalled']} of {r['concepts']}")
     print(f"recall: {r['recall']:.4f}")
     return 0
@@ -147,8 +234,13 @@ def add_commands(sub) -> None:
 
     e = s.add_parser("eval", help="recall on the 546 concepts' training pairs; prints `recall: X` last")
     e.add_argument("--weights", help="weights file (default: the shipped weights)")
-    e.add_argument("--concepts", default="all")
+    e.add_argument("--concepts", default="all", help="'all' (default), 'demo' or a comma-separated list")
     e.add_argument("--dataset", help="dataset folder (default: the shipped one)")
-    e.add_argument("--json", help="also write the full report here")
+    e.add_argument("--out", "--json", dest="out",
+                   help="write the result JSON here: recall, concepts recalled, misses, mean extra arguments "
+                        "per function, the weights' sha256, date, commit and command")
+    e.add_argument("--record", action="store_true",
+                   help="also keep the recall (all concepts, shipped examples) in the weights card; the "
+                        "weights file itself is not rewritten")
     e.add_argument("--show", type=int, default=10, help="missed concepts to list (default 10)")
     e.set_defaults(fn=cmd_recall)

@@ -87,7 +87,7 @@ def grow(rng: np.random.Generator, scenes: list[Scene], length: int,
                 m.step(op, arg)
             if any(m.failed for m in trial):
                 continue
-            if NAMES[op] not in ("loop_start", "loop_end") and not any(m.in_loop for m in trial) and all(
+            if NAMES[op] not in ("loop_start", "loop_end") and not any(m.control.in_loop for m in trial) and all(
                     _signature(a) == _signature(b) for a, b in zip(machines, trial)):
                 continue  # changes nothing the machine shows: it could only be dispensable
             if any(_scene(a) != _scene(b) for a, b in zip(machines, trial)):
@@ -107,13 +107,17 @@ def grow(rng: np.random.Generator, scenes: list[Scene], length: int,
 
 
 def _scene(m: RefMachine) -> tuple:
-    return tuple((o.x, o.y, o.color, o.alive) for o in m.objects)
+    """Each of the scene's objects: centre, colour, alive."""
+    b = m.blackboard
+    return tuple((m.centre(i), b.color[i], b.alive[i]) for i in range(len(m.scene.objects)))
 
 
 def _signature(m: RefMachine) -> tuple:
     """What a step can change that a later step can read (the fixation history aside)."""
-    return (_scene(m), m.imagined, m.fovea, m.hand, m.held,
-            m.shape_filter, m.color_filter, tuple(m.attended_list), m.stale, m.k, m.attended)
+    a, b = m.attention, m.blackboard
+    return (_scene(m), b.imagined_kind, b.imagined_position if b.imagined_kind >= 0 else None, m.fovea.position,
+            m.hand.position, m.hand.held, a.shape_filter, a.color_filter, tuple(a.attended_list), a.stale, a.cursor,
+            a.attended)
 
 
 def _deletions(program: Program):

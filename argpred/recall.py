@@ -11,7 +11,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from argpred.data import PREDICTED
-from argpred.predict import Predictor, passing
+from argpred.predict import THRESHOLD, Predictor, passing
 from vccjax.world.concepts import reference_program
 from vccjax.machine.instructions import NAMES, arg_domain
 from vccjax.machine.scene import Scene
@@ -44,3 +44,27 @@ def recall(predictor: Predictor, concepts: Sequence[str],
         "mean_extra_arguments": {f: float(np.mean(v)) for f, v in extra.items()},
         "missed": missed,
     }
+
+
+def measure(weights=None, concepts: Sequence[str] | None = None, dataset=None) -> tuple[dict, dict]:
+    """(`recall` of the weights at `weights` (default: the shipped ones) on `concepts`
+    (default: all 546) with the training pairs of `dataset` (default: the shipped
+    examples), the weights' card)."""
+    from vccjax.world.concepts import concept_names
+    from vccjax.world.dataset import dataset_for
+
+    names = list(concepts) if concepts is not None else concept_names()
+    if not names:
+        raise ValueError("no concepts to measure recall on")
+    predictor = Predictor(weights)
+    ds = dataset_for(names, 0, dataset, progress=False)
+    return recall(predictor, names, lambda c: ds.pairs(c, "train")), predictor.card
+
+
+def card_record(r: dict, date: str, command: str) -> dict:
+    """What a weights card keeps of a recall measured on all the concepts (the card's
+    `recall` field): the figures, the concepts missed and how it was measured."""
+    return {"concepts": r["concepts"], "recalled": r["recalled"], "recall": r["recall"],
+            "threshold": THRESHOLD, "examples": "training pairs of the shipped dataset",
+            "mean_extra_arguments": r["mean_extra_arguments"], "missed": r["missed"],
+            "date": date, "command": command}

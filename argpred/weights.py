@@ -3,7 +3,12 @@ with the model's settings, the labels and the sha256 of the msgpack bytes. Loadi
 checks all three and refuses a file that is cut, edited or made for another model.
 
 An ensemble (`members` > 1: networks trained alike from different seeds, whose
-probabilities are averaged) stores its parameters stacked on a leading axis."""
+probabilities are averaged) stores its parameters stacked on a leading axis.
+
+A card may also hold `recall`: what `vcc argpred eval` measured on these weights over
+the 546 concepts (`argpred.recall.card_record`), written by `vcc argpred train` after
+training or by `vcc argpred eval --record` (`record`, which leaves the msgpack bytes as
+they are). Cards without it (older weights) load as before."""
 
 from __future__ import annotations
 
@@ -55,11 +60,38 @@ def save(path: str | Path, model: ArgNet, params: dict, info: dict | None = None
              "members": members_of(params)}
     card = {"format": FORMAT, "version": VERSION, "model": shape,
             "labels": [list(x) for x in LABELS], "sha256": sha, **(info or {})}
-    tmp = path.with_suffix(".tmp")
-    tmp.write_bytes(data)
-    tmp.replace(path)
-    path.with_suffix(".json").write_text(json.dumps(card, indent=1))
+    _replace(path, data)
+    _write_card(path, card)
     return sha
+
+
+def _replace(path: Path, data: bytes) -> None:
+    """`path` replaced whole by `data`: a failed write leaves neither a cut file nor its temporary."""
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        tmp.write_bytes(data)
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _write_card(path: Path, card: dict) -> None:
+    """The card beside `path`, replaced whole."""
+    _replace(path.with_suffix(".json"), json.dumps(card, indent=1).encode())
+
+
+def record(path: str | Path | None = None, **fields) -> dict:
+    """Add `fields` to the card of the weights at `path` (default: the shipped weights),
+    after checking card and weights as `load` does; the weights file is not rewritten, so
+    its bytes and sha256 stay the same. Returns the new card."""
+    path = Path(path) if path is not None else shipped_weights()
+    reserved = {"format", "version", "model", "labels", "sha256"} & set(fields)
+    if reserved:
+        raise ValueError(f"a card's {', '.join(sorted(reserved))} come from the weights themselves")
+    _, _, card = load(path)
+    card = {**card, **fields}
+    _write_card(path, card)
+    return card
 
 
 def load(path: str | Path | None = None) -> tuple[ArgNet, dict, dict]:
@@ -84,9 +116,11 @@ def load(path: str | Path | None = None) -> tuple[ArgNet, dict, dict]:
                        depth=int(card["model"].get("depth", 1)),
                        evidence=str(card["model"].get("evidence", "signed")))
         members = int(card["model"].get("members", 1))
+        if members < 1:
+            raise ValueError(f"members {members}")
         template = init_params(model) if members == 1 else stack([init_params(model)] * members)
         params = serialization.from_bytes(template, data)
-    except (KeyError, TypeError, ValueError) as e:
+    except (KeyError, TypeError, ValueError, AttributeError) as e:  # AttributeError: msgpack of a number or list
         raise DataFileError(f"{path}: does not hold this model's weights ({e})") from None
     for a, b in zip(jax.tree.leaves(params), jax.tree.leaves(template)):
         if a.shape != b.shape:

@@ -21,12 +21,12 @@ def _program(a: argparse.Namespace):
 
 
 def cmd_run(a: argparse.Namespace) -> int:
+    program = _program(a)  # bad input ends here, before JAX and MuJoCo start
     _setup_mjx(a)
     from robot.judge import CAUSES
     from robot.control import RECORD
     from robot.rollout import Bench, scenarios_for
 
-    program = _program(a)
     bench = Bench()
     scenarios = scenarios_for(program, a.scenarios, a.seed)
     verdicts, info, records = bench.run(program, scenarios, keep=a.video is not None)

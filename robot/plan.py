@@ -57,23 +57,24 @@ class _Tracer(RefMachine):
         self._path: list[tuple[float, float]] = []
 
     def _others(self, i: int) -> tuple[tuple[float, float, float, str], ...]:
-        return tuple((*self._centre_of(j), self.objects[j].width, SHAPES[self.objects[j].shape])
+        return tuple((*self._centre_of(j), self.widths[j], SHAPES[self.shapes[j]])
                      for j in self.real_alive() if j != i)
 
     def _centre_of(self, i: int) -> tuple[float, float]:
-        o, u = self.objects[i], self.cfg.units
-        return (o.x / u, o.y / u)
+        (x, y), u = self.centre(i), self.cfg.units
+        return (x / u, y / u)
 
     def execute(self, op: int, arg: int) -> None:
         name = NAMES[op]
         if name in NOT_ON_A_ROBOT:
             raise PlanError(f"{name} {NOT_ON_A_ROBOT[name]}: not something an arm can do")
         super().execute(op, arg)
+        held = self.hand.held
         if name == "grab_object":
-            self._path = [self._centre_of(self.held)]
-            self._around = self._others(self.held)
-        elif name in _CARRIES and self.held is not None:
-            p = self._centre_of(self.held)
+            self._path = [self._centre_of(held)]
+            self._around = self._others(held)
+        elif name in _CARRIES and held >= 0:
+            p = self._centre_of(held)
             if p != self._path[-1]:
                 self._path.append(p)
         elif name == "release_object":
@@ -87,7 +88,7 @@ class _Tracer(RefMachine):
         self._path = []
 
     def op_release_object(self, arg: int) -> None:
-        self._held_before_release = self.held
+        self._held_before_release = self.hand.held
         super().op_release_object(arg)
 
 
@@ -103,10 +104,10 @@ def plan(programs: Program | Sequence[Program], scene: Scene) -> tuple[list[Pick
             m.step(op, arg)
             if m.failed:
                 where = f" of program {k + 1}" if k else ""
-                raise PlanError(f"the program failed at instruction {m.fail_index}{where} on the parsed scene: "
+                raise PlanError(f"the program failed at instruction {m.control.fail_index}{where} on the parsed scene: "
                                 f"{m.fail_reason}")
-        if m.held is not None:  # the VCC may end holding: the arm puts it down where it is
-            m._held_before_release = m.held
+        if m.hand.held >= 0:  # the VCC may end holding: the arm puts it down where it is
+            m._held_before_release = m.hand.held
             m._finish()
         moves += m.moves
         scene = m.output_scene()

@@ -28,8 +28,10 @@ import numpy as np
 
 from search.chain import Chain, uniform_args
 from search.compress import compress
-from search.explore import Explorer, Result, Task
+from search.explore import Explorer, Searcher
 from search.model import MarkovModel, Vocabulary
+from search.result import Result
+from search.task import Task
 from vccjax.world.concepts import reference_program
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import DataFileError
@@ -63,7 +65,7 @@ class Settings:
 
 def _uniform_over_used(program: Program, name: str) -> np.ndarray:
     """log p uniform over the values `program` gives instruction `name`; -inf elsewhere."""
-    used = sorted({a for o, a in zip(program.ops, program.args) if o == OP[name]})
+    used = sorted({a for o, a in zip(program.ops, program.args, strict=True) if o == OP[name]})
     lp = np.full(len(arg_domain(name)), -np.inf)
     if used:
         lp[used] = -math.log(len(used))
@@ -240,7 +242,7 @@ def _record(concept: str, it: int, r: Result, test: tuple[int, int] | None) -> d
 
 def induce(
     concepts: Sequence[str], pairs: Callable[[str, str], list[tuple[Scene, Scene]]],
-    out: str | Path, settings: Settings, explorer: Explorer | None = None,
+    out: str | Path, settings: Settings, explorer: Searcher | None = None,
     progress: bool = True, log: Callable[[str], None] = print,
     examples_sha256: Callable[[str], str] | None = None,
 ) -> Run:

@@ -2,51 +2,72 @@
 batched search is measured against (`vcc bench search`), and its oracle in tests.
 
 Only the machine differs: one `RefMachine` per (prefix, example), cloned per child and
-stepped one instruction at a time. The enumeration, cutoff, budget and pruning are
-`Explorer`'s, so both visit the same programs and must find the same one.
+stepped one instruction at a time. The enumeration, cutoff, budget and pruning are the
+same code (`search.dfs`), so both visit the same programs and must find the same one.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
-from search.explore import Explorer, Request, Task
+from search.backend import Reply, Request
+from search.explore import Searcher
+from search.task import Task
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.reference import RefMachine
 from vccjax.machine.scene import scenes_match
 
+Machines = list[list[RefMachine]]  # per prefix, one machine per example
 
-class ScalarExplorer(Explorer):
-    def root_states(self, task: Task):
-        return [[RefMachine(a, self.cfg, validate=False) for a, _ in task.pairs]]
 
-    def take(self, states, idx: np.ndarray):
-        return [states[i] for i in idx]
+class ScalarBackend:
+    """The `search.backend.Backend` on the reference interpreter. Nothing compiles and
+    there is no device bank: each machine holds its scene."""
 
-    def prepare(self, tasks) -> None:
-        pass  # no device bank: each machine holds its scene
+    compile_seconds = 0.0
 
-    def admit(self, task, active) -> None:
+    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG):
+        self.cfg = cfg
+
+    def root_states(self, task: Task) -> Machines:
+        return [[RefMachine(scene, self.cfg, validate=False) for scene, _ in task.pairs]]
+
+    def take(self, states: Machines, rows: np.ndarray) -> Machines:
+        return [states[i] for i in rows]
+
+    def admit(self, task: Task, alongside: Sequence[Task]) -> None:
         pass
 
-    def apply_many(self, requests: list[Request]):
+    def apply_many(self, requests: Sequence[Request]) -> list[Reply]:
         return [self.apply(r) for r in requests]
 
-    def apply(self, request: Request):
-        chain, task, portions, may_end = request.chain, request.task, request.portions, request.may_end
-        states = [request.states[i] for i in request.parents]
-        out, failed, ok = [], np.zeros(len(portions), bool), np.zeros(len(portions), bool)
-        for i, (machines, z) in enumerate(zip(states, portions)):
-            kids = []
-            for m in machines:
-                k = m.clone()
-                for op, arg in zip(chain.ops[z], chain.args[z]):
-                    k.step(op, arg)
-                kids.append(k)
-                if k.failed:  # the program fails on this example: no need to run the rest
+    def apply(self, request: Request) -> Reply:
+        """One request: each child's parent machines cloned and stepped by its portion,
+        stopping at the first example it fails on; those that may end judged on the host."""
+        chain, task = request.chain, request.task
+        n = len(request.portions)
+        children, failed, solved = [], np.zeros(n, bool), np.zeros(n, bool)
+        for i, portion in enumerate(request.portions):
+            machines = []
+            for machine in request.states[request.parents[i]]:
+                child = machine.clone()
+                for op, arg in zip(chain.ops[portion], chain.args[portion], strict=True):
+                    child.step(op, arg)
+                machines.append(child)
+                if child.failed:  # the program fails on this example: no need to run the rest
                     failed[i] = True
                     break
-            out.append(kids)
-            if not failed[i] and may_end[i]:
-                ok[i] = all(scenes_match(k.output_scene(), b, self.cfg.tau)
-                            for k, (_, b) in zip(kids, task.pairs))
-        return out, failed, ok
+            children.append(machines)
+            if not failed[i] and request.may_end[i]:
+                solved[i] = all(scenes_match(m.output_scene(), output, self.cfg.tau)
+                                for m, (_, output) in zip(machines, task.pairs, strict=True))
+        return Reply(children, failed, solved)
+
+
+class ScalarExplorer(Searcher):
+    """The search on the reference interpreter (`ScalarBackend`)."""
+
+    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, chunk: int = 256, slice_size: int = 256, width: int = 32):
+        super().__init__(ScalarBackend(cfg), chunk, slice_size, width)

@@ -41,7 +41,7 @@ def _batched(cfg: VCCConfig, op: int, make, first, states, *rest):
     state in the batch holds an object."""
     if op not in EMPTY_HANDED:
         return make(None)(first, states, *rest)
-    return jax.lax.cond(jnp.any(states.held >= 0), make(None), make(EMPTY_HANDED[op]), first, states, *rest)
+    return jax.lax.cond(jnp.any(states.hand.held >= 0), make(None), make(EMPTY_HANDED[op]), first, states, *rest)
 
 
 def _per_task(consts: SceneConst, one, example_axes: tuple):
@@ -79,7 +79,8 @@ def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Array,
 def loop_needs_iteration(cfg: VCCConfig, s: VCCState, iteration) -> jax.Array:
     """Whether a just-closed loop runs another iteration (`iteration` = iterations done;
     docs/vcc.md section 5: while k < len(A), at most n_max in all, the first ran eagerly)."""
-    return s.loop_active & ~s.failed & (iteration < cfg.n_max) & (s.cursor < s.attn_len)
+    ctl, a = s.control, s.attention
+    return ctl.loop_active & ~ctl.failed & (iteration < cfg.n_max) & (a.cursor < a.attended_list_len)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 1))
@@ -91,7 +92,7 @@ def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Arra
 
     def per_program(fn):
         def one(c, s, arg, pc, act):
-            return select(act & ~s.failed, execute(cfg, c, s, op, arg, pc, fn), s)
+            return select(act & ~s.control.failed, execute(cfg, c, s, op, arg, pc, fn), s)
 
         return _per_task(consts, one, (None, None, 0))
 

@@ -13,7 +13,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from conftest import summary_jax, summary_ref
+from conftest import agree, same_jax
 
 from vccjax.machine import step as emulator
 from vccjax.machine.config import DEFAULT_CONFIG as CFG
@@ -56,8 +56,7 @@ def check_cases(cases, cfg=CFG, batch=BATCH) -> dict:
             ref = RefMachine(sc, cfg).run(prog)
             st = jax.tree.map(lambda x: x[i], out)
             c = jax.tree.map(lambda x: x[i], host_consts)
-            a, b = summary_ref(ref), summary_jax(st, c, cfg)
-            assert a == b, f"case {start + i}: {prog}\nscene {sc}\nref {a}\njax {b}"
+            agree(ref, st, f" on case {start + i}: {prog}\nscene {sc}")
             stats["failed"] += ref.failed
             stats["loops"] += "loop_end" in prog.text()
             if not ref.failed:
@@ -66,6 +65,17 @@ def check_cases(cases, cfg=CFG, batch=BATCH) -> dict:
                 mine.validate(cfg)  # objects stay inside the workspace and never overlap
                 stats["moved"] += not scenes_match(mine, sc, cfg.tau)
     return stats
+
+
+def test_both_machines_hold_the_same_memories_under_the_same_names():
+    """One vocabulary: the same memories and fields in both machines (JAX's padded arrays
+    cut by their length fields), equal before any instruction; a difference is named."""
+    from vccjax.machine.memories import MEMORIES, first_difference, memories
+
+    ref, st = RefMachine(random_scene(np.random.default_rng(0), 3)), init_state(CFG)
+    assert tuple(memories(st)) == MEMORIES and memories(ref) == memories(st)
+    ref.hand.held = 2
+    assert first_difference(memories(ref), memories(st)) == "hand.held: 2 != -1"
 
 
 def test_jax_and_reference_agree_on_2000_random_cases():
@@ -111,10 +121,10 @@ def test_step_batch_grouped_by_instruction_matches_whole_program_runs():
                 stepped, states,
             )
     whole = emulator.run_programs(CFG, consts, jnp.asarray(ops), args)
-    host_s, host_w, host_c = jax.device_get((states, whole, consts))
+    host_s, host_w = jax.device_get((states, whole))
     for i in range(len(cases)):
         pick = lambda t: jax.tree.map(lambda x: x[i], t)  # noqa: E731
-        assert summary_jax(pick(host_s), pick(host_c)) == summary_jax(pick(host_w), pick(host_c)), i
+        assert same_jax(pick(host_s), pick(host_w)), i
 
 
 def test_run_batch_shares_one_program_over_scenes():
@@ -125,8 +135,7 @@ def test_run_batch_shares_one_program_over_scenes():
     out = jax.device_get(emulator.run_batch(CFG, stack([load_scene(s) for s in scenes]),
                                             jnp.asarray(o), jnp.asarray(a)))
     for i, sc in enumerate(scenes):
-        c = jax.device_get(load_scene(sc))
-        assert summary_jax(jax.tree.map(lambda x: x[i], out), c) == summary_ref(RefMachine(sc).run(prog))
+        agree(RefMachine(sc).run(prog), jax.tree.map(lambda x: x[i], out))
 
 
 def test_no_retracing_across_programs_and_scenes():
@@ -138,8 +147,8 @@ def test_no_retracing_across_programs_and_scenes():
         sc = random_scene(rng, (1, 8), pointer=True)
         o, a, _ = random_deep_program(rng, sc, max_len=20).arrays(LENGTH)
         c = load_scene(sc)
-        traced(CFG, c, jnp.asarray(o), jnp.asarray(a)).failed.block_until_ready()
-        emulator.run_program(CFG, c, jnp.asarray(o), jnp.asarray(a)).failed.block_until_ready()
+        traced(CFG, c, jnp.asarray(o), jnp.asarray(a)).control.failed.block_until_ready()
+        emulator.run_program(CFG, c, jnp.asarray(o), jnp.asarray(a)).control.failed.block_until_ready()
     assert emulator.run_program._cache_size() - before <= 1
     step_traced = jax.jit(chex.assert_max_traces(emulator.step, n=1), static_argnums=0)
     s = init_state(CFG)
@@ -166,17 +175,18 @@ def test_derived_raster_masks_and_grid_match_the_reference_pixels():
         st = emulator.run_program(CFG, c, jnp.asarray(o), jnp.asarray(a))
         masks = np.asarray(object_masks(c, st, CFG))
         cells = np.asarray(grid15(c, st, CFG))
-        for i, ob in enumerate(ref.objects):
+        for i, alive in enumerate(ref.blackboard.alive):
             want = np.zeros((CFG.raster, CFG.raster), bool)
-            if ob.alive:
+            if alive:
                 rows, cols = zip(*ref.pixels(i))
                 want[list(rows), list(cols)] = True
-                assert tuple(cells[i]) == (ob.x * 14 // CFG.units, ob.y * 14 // CFG.units)
+                assert tuple(cells[i]) == tuple(v * 14 // CFG.units for v in ref.centre(i))
             assert (masks[i] == want).all(), (i, prog)
         imag = np.zeros((CFG.raster, CFG.raster), bool)
         for r, col in ref.imagined_set():
             imag[r, col] = True
-        assert np.array_equal(np.asarray(imagined_runs(st.imag_kind, st.imag_pos, CFG)[0]), _lines(imag))
+        b = st.blackboard
+        assert np.array_equal(np.asarray(imagined_runs(b.imagined_kind, b.imagined_position, CFG)[0]), _lines(imag))
         checked += 1
     assert checked >= 20
 
@@ -194,19 +204,19 @@ def test_carry_ops_skip_the_carry_only_when_nothing_is_held(holding):
     prefix += "; grab_object" if holding else ""
     consts = stack([load_scene(s) for s in scenes])
     states = emulator.run_batch(CFG, consts, *(jnp.asarray(a) for a in parse(prefix).arrays(LENGTH)[:2]))
-    assert bool(jnp.any(states.held >= 0)) == holding
+    assert bool(jnp.any(states.hand.held >= 0)) == holding
     one_example = lambda t: jax.tree.map(lambda x: x[:, None], t)  # noqa: E731  each scene a task of 1 example
     tasks, zeros = jnp.arange(len(scenes)), jnp.zeros(len(scenes), jnp.int32)
     for op in EMPTY_HANDED:
         batched = step_examples(CFG, op, one_example(consts), tasks, one_example(states), zeros)
         batched = jax.tree.map(lambda x: x[:, 0], batched)
         full = jax.vmap(lambda c, s, op=op: emulator.step_op(CFG, c, s, op, jnp.int32(0)))(consts, states)
-        host_b, host_f, host_c = jax.device_get((batched, full, consts))
+        host_b, host_f = jax.device_get((batched, full))
         for i, sc in enumerate(scenes):
             pick = lambda t, i=i: jax.tree.map(lambda x: x[i], t)  # noqa: E731
             ref = RefMachine(sc).run(parse(f"{prefix}; {NAMES[op]}"))
-            assert summary_jax(pick(host_b), pick(host_c)) == summary_jax(pick(host_f), pick(host_c))
-            assert summary_jax(pick(host_b), pick(host_c)) == summary_ref(ref)
+            assert same_jax(pick(host_b), pick(host_f))
+            agree(ref, pick(host_b))
 
 
 def _lines(m: np.ndarray) -> np.ndarray:

@@ -237,9 +237,156 @@ def test_shipped_weights_load_and_read_a_colour_change(capsys):
     probs = p.for_pairs(pairs)
     assert probs["fill_color"][1:].argmax() + 1 == 2  # blue, of the colours not already there
     assert probs["fill_color"][2] >= THRESHOLD
-    assert main(["argpred", "eval", "--concepts", "remove_bottom_obj,change_all_objs_color"]) == 0
+    two = ["remove_bottom_obj", "change_all_objs_color"]
+    assert main(["argpred", "eval", "--concepts", ",".join(two)]) == 0
     out = capsys.readouterr().out.strip().splitlines()
-    assert out[-1].startswith("recall: ") and 0 <= float(out[-1].split()[1]) <= 1
+    recalled = [c for c in two if c not in p.card["recall"]["missed"]]  # what the card's measurement says
+    assert out[-2:] == [f"concepts recalled: {len(recalled)} of 2", f"recall: {len(recalled) / 2:.4f}"]
+
+
+def _copy_shipped(folder, keep_recall: bool = True):
+    """The shipped weights copied to `folder` (the card without `recall` unless kept)."""
+    from argpred.weights import shipped_weights
+
+    src = shipped_weights()
+    dst = folder / "w.msgpack"
+    dst.write_bytes(src.read_bytes())
+    card = json.loads(src.with_suffix(".json").read_text())
+    if not keep_recall:
+        card.pop("recall", None)
+    dst.with_suffix(".json").write_text(json.dumps(card))
+    return dst
+
+
+def test_shipped_weights_recall_what_their_card_records(tmp_path, capsys):
+    """The shipped weights, measured again on all 546 concepts (7 s), recall what their card
+    recorded when they were made; `eval --record` writes that record into a card that lacks
+    it (as the shipped one's was) without touching the weights, and `--out` the result."""
+    import datetime
+    from pathlib import Path
+
+    from argpred.weights import shipped_weights
+    from vcc.cli import main
+    from vccjax.world.concepts import concept_names
+
+    shipped = json.loads(shipped_weights().with_suffix(".json").read_text())
+    card = shipped["recall"]  # a card without it: KeyError, the test fails
+    copy = _copy_shipped(tmp_path, keep_recall=False)
+    assert "recall" not in load(copy)[2]  # an older card loads as before
+    out = tmp_path / "res" / "recall.json"
+    assert main(["argpred", "eval", "--weights", str(copy), "--record", "--out", str(out), "--show", "0"]) == 0
+    printed = capsys.readouterr().out.strip().splitlines()
+    r = json.loads(out.read_text())
+    # measured now == recorded then
+    assert r["concepts"] == card["concepts"] == len(concept_names())
+    assert r["recalled"] == card["recalled"] and r["missed"] == card["missed"]
+    assert r["recall"] == card["recall"] == r["recalled"] / r["concepts"]
+    for f, v in card["mean_extra_arguments"].items():
+        assert r["mean_extra_arguments"][f] == pytest.approx(v, abs=1e-9)
+    assert r["recalled"] == r["concepts"] - len(r["missed"])
+    assert printed[-2:] == [f"concepts recalled: {r['recalled']} of {r['concepts']}", f"recall: {r['recall']:.4f}"]
+    # the result file says what was measured, with what, when and how
+    assert r["weights_sha256"] == shipped["sha256"] and r["members"] == shipped["model"]["members"]
+    assert r["command"] == f"vcc argpred eval --weights {copy} --out {out} --record"
+    assert r["benchmark"] == "argpred-recall" and r["seconds"] > 0
+    now = datetime.datetime.now(datetime.timezone.utc)
+    assert abs(datetime.datetime.fromisoformat(r["date"]) - now).total_seconds() < 600
+    # --record: the copy's card now holds the same record; its weights are the same bytes
+    _, _, new = load(copy)
+    assert new["recall"]["recalled"] == card["recalled"] and new["recall"]["missed"] == card["missed"]
+    assert new["recall"]["command"] == f"vcc argpred eval --weights {copy}" and new["sha256"] == shipped["sha256"]
+    assert copy.read_bytes() == shipped_weights().read_bytes()
+    assert {k: v for k, v in new.items() if k != "recall"} == {k: v for k, v in shipped.items() if k != "recall"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["res", "w.json", "w.msgpack"]  # no temporary left
+    # the committed result that README cites is of these weights and says the same
+    committed = json.loads((Path(__file__).parents[1] / "benchmarks" / "results" / "argpred-recall.json").read_text())
+    assert committed["weights_sha256"] == shipped["sha256"], "benchmarks/results/argpred-recall.json: rerun it"
+    assert (committed["recalled"], committed["concepts"], committed["missed"]) == (r["recalled"], r["concepts"],
+                                                                                   r["missed"])
+
+
+def _one_error_line(capsys, fragment: str) -> None:
+    err = capsys.readouterr().err
+    assert err.startswith("vcc: error: ") and err.count("\n") == 1 and fragment in err, err
+
+
+def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_path, capsys, monkeypatch):
+    from argpred import cli as argcli
+    from vcc.cli import main
+
+    monkeypatch.setattr(argcli, "DEFAULT_DATA", tmp_path / "default-data")  # where train would draw its data
+    w, d, res = tmp_path / "new.msgpack", tmp_path / "data", tmp_path / "r.json"
+    train = ["argpred", "train", "--out", str(w), "--quiet"]
+    for argv, fragment in [
+        (train + ["--epochs", "0"], "--epochs must be at least 1, got 0"),
+        (train + ["--lr", "nan"], "--lr must be a positive number, got nan"),
+        (train + ["--lr", "-0.1"], "--lr must be a positive number, got -0.1"),
+        (train + ["--positive-weight", "inf"], "--positive-weight must be a positive number, got inf"),
+        (train + ["--l1", "-1"], "--l1 must be 0 or a positive number"),
+        (train + ["--members", "0"], "--members must be at least 1"),
+        (train + ["--batch", "0"], "--batch must be at least 1"),
+        (train + ["--programs", "0"], "--programs must be at least 1"),
+        (train + ["--joined", "1.5"], "--joined must be a share from 0 to 1, got 1.5"),
+        (train + ["--carry", "-1"], "--carry must be 0 or more"),
+        (["argpred", "train", "--out", str(tmp_path), "--quiet"], "a folder; give the weights file"),
+        (["argpred", "data", "--out", str(d), "--programs", "0"], "--programs must be at least 1"),
+        (["argpred", "data", "--out", str(d), "--joined", "nan"], "--joined must be a share from 0 to 1, got nan"),
+        (["argpred", "eval", "--concepts", "", "--out", str(res)], "names no concept"),
+        (["argpred", "eval", "--concepts", "no_such", "--out", str(res)], "unknown concept(s): no_such"),
+        (["argpred", "eval", "--show", "-1", "--out", str(res)], "--show must be 0 or more"),
+        (["argpred", "eval", "--record", "--concepts", "remove_bottom_obj"], "--record keeps the recall on all"),
+        (["argpred", "eval", "--weights", str(tmp_path / "none.msgpack"), "--out", str(res)], "none.json: missing"),
+    ]:
+        assert main(argv) == 2, argv
+        _one_error_line(capsys, fragment)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing drawn, trained or written
+    # corrupt weights: refused, and --record leaves the card as it was
+    copy = _copy_shipped(tmp_path)
+    data = bytearray(copy.read_bytes())
+    data[len(data) // 3] ^= 0x01
+    copy.write_bytes(bytes(data))
+    card = copy.with_suffix(".json").read_bytes()
+    good = json.loads(card)
+    assert main(["argpred", "eval", "--weights", str(copy), "--record", "--out", str(res)]) == 2
+    _one_error_line(capsys, "sha256 differs from its card")
+    assert copy.with_suffix(".json").read_bytes() == card
+    copy.with_suffix(".json").write_text("{cut")
+    assert main(["argpred", "eval", "--weights", str(copy), "--out", str(res)]) == 2
+    _one_error_line(capsys, "w.json: not JSON")
+    import hashlib
+
+    import msgpack
+
+    for body in (msgpack.packb(5), msgpack.packb([1, 2]), b""):  # the card's sha256 matches, the content is not weights
+        copy.write_bytes(body)
+        copy.with_suffix(".json").write_text(json.dumps({**good, "sha256": hashlib.sha256(body).hexdigest()}))
+        assert main(["argpred", "eval", "--weights", str(copy), "--out", str(res)]) == 2
+        _one_error_line(capsys, "does not hold this model's weights")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["w.json", "w.msgpack"]
+
+
+def test_train_records_the_recall_of_what_it_trained_in_the_card(tiny, tmp_path, capsys):
+    """`vcc argpred train` ends by measuring the new weights on all the concepts and keeping
+    that in their card; measured again on a few concepts, they miss what the card says."""
+    import shutil
+
+    from argpred.recall import measure
+    from vcc.cli import main
+    from vccjax.world.concepts import concept_names
+
+    data = tmp_path / "data"
+    shutil.copytree(tiny, data)
+    w = tmp_path / "w.msgpack"
+    assert main(["argpred", "train", "--data", str(data), "--epochs", "1", "--members", "1", "--carry", "0",
+                 "--hidden", "4", "--batch", "8", "--workers", "1", "--out", str(w), "--quiet"]) == 0
+    printed = capsys.readouterr().out
+    rec = load(w)[2]["recall"]
+    assert rec["concepts"] == len(concept_names()) and rec["recalled"] == rec["concepts"] - len(rec["missed"])
+    assert f"concepts recalled: {rec['recalled']} of {rec['concepts']}" in printed
+    some = concept_names()[::50]
+    r, _ = measure(w, some)
+    assert set(r["missed"]) == set(rec["missed"]) & set(some)
+    assert all(r["missed"][c] == rec["missed"][c] for c in r["missed"])
 
 
 def test_induce_with_predicted_arguments(tmp_path, capsys, monkeypatch):

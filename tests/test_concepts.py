@@ -7,7 +7,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from conftest import obj, run_both, scene, summary_jax, summary_ref
+from conftest import agree, obj, run_both, scene
 
 from vccjax.machine import step as emulator
 from vccjax.world.concepts import LICENSE, all_concepts, concept_names, reference_program
@@ -27,7 +27,7 @@ def test_concept_file_is_complete_and_licensed():
     import json
     from importlib import resources
 
-    d = json.loads(resources.files("vccjax").joinpath("data/concepts.json").read_text())
+    d = json.loads(resources.files("vccjax.world").joinpath("data/concepts.json").read_text())
     assert d["license"] == LICENSE
     lengths = [len(p) for p in all_concepts().values()]
     assert min(lengths) == 4 and max(lengths) == 23  # the paper's figures
@@ -55,15 +55,15 @@ def test_every_reference_program_runs_and_changes_a_random_scene():
     out = jax.device_get(emulator.run_programs(
         CFG, consts, jnp.asarray(np.stack([a[0] for a in arrays])),
         jnp.asarray(np.stack([a[1] for a in arrays]))))
-    host_c = jax.device_get(consts)
     for i, (name, (_, _, m)) in enumerate(chosen.items()):
         pick = lambda t: jax.tree.map(lambda x: x[i], t)  # noqa: E731
-        assert summary_jax(pick(out), pick(host_c)) == summary_ref(m), name
+        agree(m, pick(out), f" on {name}")
 
 
 def _centre(m, i):
     u = CFG.units
-    return m.objects[i].x / u, m.objects[i].y / u
+    x, y = m.centre(i)
+    return x / u, y / u
 
 
 def test_trace_chained_movement_left_most_object():
@@ -78,15 +78,15 @@ def test_trace_chained_movement_left_most_object():
         m.step(op, arg)
         assert not m.failed, (i, m.fail_reason)
         run_both(type(prog)(prog.ops[: i + 1], prog.args[: i + 1]), sc)  # every prefix agrees
-        seen.append((prog.steps()[i][0], [_centre(m, j) for j in range(4)], m.fovea))
+        seen.append((prog.steps()[i][0], [_centre(m, j) for j in range(4)], m.fovea.position))
     # after fixate(left) + top_down_attend the leftmost object is attended
-    assert seen[2][0] == "top_down_attend" and m.objects[0].alive
+    assert seen[2][0] == "top_down_attend" and m.blackboard.alive[0]
     out = m.output_scene().objects
     assert out[0].x - out[0].width / 2 == pytest.approx(0.0, abs=1 / 64)  # at the left edge
     for j in (1, 2, 3):  # each object took its predecessor's place
         assert abs(out[j].x - sc.objects[j - 1].x) <= TAU and abs(out[j].y - sc.objects[j - 1].y) <= TAU
     # the loop ran for the three remaining objects: history = centre, left, then 4 objects
-    assert len(m.history) == 6
+    assert len(m.fovea.history) == 6
 
 
 def test_trace_swap_locations():
@@ -97,7 +97,7 @@ def test_trace_swap_locations():
         m.step(op, arg)
         assert not m.failed, (i, prog.steps()[i], m.fail_reason)
         if prog.steps()[i][0] == "move_hand_down":  # the first object was parked at the bottom
-            assert m.objects[0].y / CFG.units + 0.05 == pytest.approx(1.0, abs=1 / 64)
+            assert _centre(m, 0)[1] + 0.05 == pytest.approx(1.0, abs=1 / 64)
     run_both(prog, sc)
     a, b = m.output_scene().objects
     assert abs(a.x - 0.8) <= TAU and abs(a.y - 0.3) <= TAU  # red square where the circle was

@@ -32,7 +32,7 @@ def run_jax(program, c):
 
 
 def jax_verdict(c, s, target: Scene) -> int:
-    return int(_verdict(c, s, load_target(target, CFG)))
+    return int(_verdict(c, s.blackboard, load_target(target, CFG)))
 
 
 def candidates(a: Scene, b: Scene, tau: float) -> np.ndarray:
@@ -76,7 +76,7 @@ def test_verdict_agrees_with_scenes_match():
             prog = draw_program(rng, sc)
             ref = RefMachine(sc, CFG).run(prog)
             s = run_jax(prog, c)
-            assert bool(s.failed) == ref.failed, f"case {case}: {prog}"
+            assert bool(s.control.failed) == ref.failed, f"case {case}: {prog}"
             if ref.failed:
                 failed_runs += 1
                 continue
@@ -130,7 +130,7 @@ def test_verdict_agrees_with_scenes_match():
 def _parsed(sc: Scene, validate: bool = True):
     c = load_scene(sc, CFG, validate=validate)
     s = run_jax(parse("scene_parse"), c)
-    assert not bool(s.failed)
+    assert not bool(s.control.failed)
     return c, s
 
 

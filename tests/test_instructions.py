@@ -10,6 +10,8 @@ rules, zero-iteration loops, failure indices inside loop replays, and the rules 
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from conftest import obj, run_both, scene
@@ -43,24 +45,42 @@ def color_id(name: str) -> int:
 
 
 def centre_of(m, i: int) -> tuple[int, int]:
-    return m.objects[i].x, m.objects[i].y
+    return m.centre(i)
+
+
+def slot(m, i: int) -> SimpleNamespace:
+    """Object slot i as the reference's blackboard holds it (centre in units)."""
+    x, y = m.centre(i)
+    b = m.blackboard
+    return SimpleNamespace(shape=m.shapes[i], color=b.color[i], x=x, y=y, width=m.widths[i], alive=b.alive[i])
+
+
+def colors(m) -> list[int]:
+    """The scene's objects' colours on the blackboard."""
+    return m.blackboard.color[: len(m.scene.objects)]
+
+
+def imagined(m) -> tuple[int, int, int] | None:
+    """(kind, x, y) of the imagined object, or None."""
+    b = m.blackboard
+    return None if b.imagined_kind < 0 else (b.imagined_kind, *b.imagined_position)
 
 
 def mask(m, i: int, dx: int = 0, dy: int = 0) -> set[tuple[int, int]]:
     """(row, col) pixels of object i, shifted by (dx, dy) whole pixels, from geometry directly."""
-    o = m.objects[i]
-    rows, cols = object_pixels(o.shape, o.width, o.x + dx * SUB, o.y + dy * SUB, CFG)
+    o = slot(m, i)
+    rows, cols = object_pixels(SHAPES[o.shape], o.width, o.x + dx * SUB, o.y + dy * SUB, CFG)
     return set(zip(rows.tolist(), cols.tolist()))
 
 
 def obstacles(m, i: int) -> set[tuple[int, int]]:
     """Pixels of every alive object except i, plus the imagined object's footprint."""
     out: set[tuple[int, int]] = set()
-    for j, o in enumerate(m.objects):
-        if j != i and o.alive:
+    for j in m.real_alive():
+        if j != i:
             out |= mask(m, j)
-    if m.imagined is not None:
-        rows, cols = imagined_pixels(*m.imagined, CFG)
+    if imagined(m) is not None:
+        rows, cols = imagined_pixels(*imagined(m), CFG)
         out |= set(zip(rows.tolist(), cols.tolist()))
     return out
 
@@ -68,8 +88,8 @@ def obstacles(m, i: int) -> set[tuple[int, int]]:
 def assert_no_overlap(m) -> None:
     """The output scene has no overlapping masks (and lies inside the workspace)."""
     m.output_scene().validate(CFG)
-    held = m.held
-    if held is not None:
+    held = m.hand.held
+    if held >= 0:
         assert not (mask(m, held) & obstacles(m, held))
 
 
@@ -83,7 +103,7 @@ def assert_in_contact(m, i: int, steps: list[tuple[int, int]]) -> None:
 
 def box_gap(m, i, direction):
     """Distance from object i's w x w box to the workspace border on one side (>= 0)."""
-    o = m.objects[i]
+    o = slot(m, i)
     x, y, h = o.x / U, o.y / U, o.width / 2
     gap = {"left": x - h, "right": 1 - x - h, "up": y - h, "down": 1 - y - h}[direction]
     assert gap >= 0
@@ -96,7 +116,7 @@ def mask_extent(m, i: int) -> tuple[int, int, int, int]:
 
 
 def alive_ids(m) -> list[int]:
-    return [i for i, o in enumerate(m.objects) if o.alive]
+    return m.real_alive()
 
 
 def with_arg(name: str) -> str:
@@ -132,16 +152,16 @@ class TestSceneParse:
         sc = scene(obj("star", "yellow", 0.25, 0.75), obj("triangle", "blue", 0.7, 0.3),
                    pointer=(0.3, 0.6))
         m, _ = run_both("scene_parse", sc)
-        assert not m.failed and m.parsed
-        assert [(o.shape, o.color, o.x, o.y, o.alive) for o in m.objects] == [
+        assert not m.failed and m.blackboard.parsed
+        assert [(o.shape, o.color, o.x, o.y, o.alive) for o in (slot(m, 0), slot(m, 1))] == [
             (shape_id("star"), color_id("yellow"), 256, 768, True),
             (shape_id("triangle"), color_id("blue"), u(0.7), u(0.3), True),
         ]
         assert m.pointer == (u(0.3), u(0.6))
         # the rest of the machine is in its initial state
-        assert m.fovea == CENTRE and m.history == [CENTRE] and m.h == 0
-        assert m.hand == CENTRE and m.held is None and m.attended is None
-        assert m.stale and m.k == 0 and m.imagined is None
+        assert m.fovea.position == CENTRE and m.fovea.history == [CENTRE] and m.fovea.history_index == 0
+        assert m.hand.position == CENTRE and m.hand.held < 0 and m.attention.attended < 0
+        assert m.attention.stale and m.attention.cursor == 0 and m.blackboard.imagined_kind < 0
         out = m.output_scene().objects
         assert [(o.shape, o.color, o.width) for o in out] == [(o.shape, o.color, o.width) for o in sc.objects]
         # positions are rounded to the nearest unit (at most half a unit off)
@@ -149,34 +169,34 @@ class TestSceneParse:
 
     def test_empty_scene_parses(self):
         m, _ = run_both("scene_parse", scene())
-        assert not m.failed and m.objects == []
+        assert not m.failed and m.blackboard.parsed and alive_ids(m) == []
 
     def test_second_scene_parse_fails(self):
         m, _ = run_both("scene_parse; fixate(left); scene_parse", THREE)
-        assert m.failed and m.fail_index == 2
+        assert m.failed and m.control.fail_index == 2
         assert "scene_parse" in m.fail_reason
 
     @pytest.mark.parametrize("name", [n for n in NAMES if n != "scene_parse"])
     def test_every_instruction_before_scene_parse_fails(self, name):
         sc = scene(obj("square", "red", 0.5, 0.5), pointer=(0.5, 0.5))
         m, st = run_both(f"{with_arg(name)}; scene_parse", sc)
-        assert m.failed and m.fail_index == 0
+        assert m.failed and m.control.fail_index == 0
         assert m.fail_reason == "no scene parsed yet"
-        assert not m.parsed and int(st.fail_index) == 0
+        assert not m.blackboard.parsed and int(st.control.fail_index) == 0
 
     def test_failed_machine_ignores_later_instructions(self):
         m, st = run_both("scene_parse; release_object; fixate(left); top_down_attend", THREE)
-        assert m.failed and m.fail_index == 1
-        assert m.history == [CENTRE] and m.attended is None
+        assert m.failed and m.control.fail_index == 1
+        assert m.fovea.history == [CENTRE] and m.attention.attended < 0
         # the JAX state also stayed as it was before the failure
-        assert int(st.hist_len) == 1 and int(st.attended) == -1 and int(st.fail_index) == 1
+        assert int(st.fovea.history_len) == 1 and int(st.attention.attended) == -1 and int(st.control.fail_index) == 1
 
     def test_failing_instruction_leaves_jax_state_unchanged(self):
         m, st = run_both("scene_parse; fixate(left); fixate_next", THREE)
-        assert m.failed and m.fail_index == 2
-        assert m.fovea == (0, C) and m.h == 1
-        assert tuple(int(v) for v in st.fovea) == (0, C)
-        assert int(st.hist_idx) == 1 and int(st.hist_len) == 2
+        assert m.failed and m.control.fail_index == 2
+        assert m.fovea.position == (0, C) and m.fovea.history_index == 1
+        assert tuple(int(v) for v in st.fovea.position) == (0, C)
+        assert int(st.fovea.history_index) == 1 and int(st.fovea.history_len) == 2
 
 
 # =========================================================================================
@@ -189,45 +209,45 @@ class TestSetShapeAttn:
             FILTER_SCENE,
         )
         assert not m.failed
-        assert m.shape_filter == shape_id("circle") and m.color_filter is None
-        assert m.stale and m.k == 0 and m.attended is None
+        assert m.attention.shape_filter == shape_id("circle") and m.attention.color_filter < 0
+        assert m.attention.stale and m.attention.cursor == 0 and m.attention.attended < 0
 
     def test_filters_attended_list_by_shape(self):
         m, _ = run_both("scene_parse; set_shape_attn(square); top_down_attend", FILTER_SCENE)
-        assert m.attended_list == [1, 0] and m.attended == 1
+        assert m.attention.attended_list == [1, 0] and m.attention.attended == 1
 
     def test_fails_when_shape_filter_already_set(self):
         m, _ = run_both("scene_parse; set_shape_attn(circle); set_shape_attn(square)", FILTER_SCENE)
-        assert m.failed and m.fail_index == 2 and "already set" in m.fail_reason
+        assert m.failed and m.control.fail_index == 2 and "already set" in m.fail_reason
 
     def test_fails_when_set_again_to_the_same_shape(self):
         m, _ = run_both("scene_parse; set_shape_attn(circle); set_shape_attn(circle)", FILTER_SCENE)
-        assert m.failed and m.fail_index == 2
+        assert m.failed and m.control.fail_index == 2
 
     def test_color_filter_does_not_block_shape_filter(self):
         m, _ = run_both("scene_parse; set_color_attn(red); set_shape_attn(circle)", FILTER_SCENE)
         assert not m.failed
-        assert (m.shape_filter, m.color_filter) == (shape_id("circle"), color_id("red"))
+        assert (m.attention.shape_filter, m.attention.color_filter) == (shape_id("circle"), color_id("red"))
 
     def test_can_be_set_again_after_reset_attn(self):
         m, _ = run_both(
             "scene_parse; set_shape_attn(circle); reset_attn; set_shape_attn(square); top_down_attend",
             FILTER_SCENE,
         )
-        assert not m.failed and m.shape_filter == shape_id("square") and m.attended_list == [1, 0]
+        assert not m.failed and m.attention.shape_filter == shape_id("square") and m.attention.attended_list == [1, 0]
 
     def test_no_match_gives_empty_list_and_top_down_attend_fails(self):
         m, _ = run_both("scene_parse; set_shape_attn(star); top_down_attend", FILTER_SCENE)
-        assert m.failed and m.fail_index == 2
+        assert m.failed and m.control.fail_index == 2
         m, _ = run_both("scene_parse; set_shape_attn(star); next_object", FILTER_SCENE)
-        assert m.failed and m.fail_index == 2  # k = 1 > len(A) = 0
+        assert m.failed and m.control.fail_index == 2  # k = 1 > len(A) = 0
 
     def test_forbidden_in_loop_body(self):
         m, _ = run_both(
             "scene_parse; loop_start; top_down_attend; set_shape_attn(circle); next_object; loop_end",
             FILTER_SCENE,
         )
-        assert m.failed and m.fail_index == 3 and "loop body" in m.fail_reason
+        assert m.failed and m.control.fail_index == 3 and "loop body" in m.fail_reason
 
 
 class TestSetColorAttn:
@@ -237,12 +257,12 @@ class TestSetColorAttn:
             FILTER_SCENE,
         )
         assert not m.failed
-        assert m.color_filter == color_id("blue") and m.shape_filter is None
-        assert m.stale and m.k == 0 and m.attended is None
+        assert m.attention.color_filter == color_id("blue") and m.attention.shape_filter < 0
+        assert m.attention.stale and m.attention.cursor == 0 and m.attention.attended < 0
 
     def test_filters_attended_list_by_color(self):
         m, _ = run_both("scene_parse; set_color_attn(red); top_down_attend", FILTER_SCENE)
-        assert m.attended_list == [2, 0] and m.attended == 2
+        assert m.attention.attended_list == [2, 0] and m.attention.attended == 2
 
     @pytest.mark.parametrize(
         "shape, color, expected",
@@ -253,28 +273,28 @@ class TestSetColorAttn:
         m, _ = run_both(f"scene_parse; set_shape_attn({shape}); set_color_attn({color}); next_object",
                         FILTER_SCENE)
         if expected:
-            assert not m.failed and m.attended_list == expected
+            assert not m.failed and m.attention.attended_list == expected
         else:  # next_object: k = 1 > len(A) = 0
-            assert m.failed and m.fail_index == 3
+            assert m.failed and m.control.fail_index == 3
 
     def test_color_filter_sees_filled_color(self):
         m, _ = run_both(
             "scene_parse; top_down_attend; fill_color(green); set_color_attn(green); top_down_attend",
             FILTER_SCENE,
         )
-        assert not m.failed and m.attended_list == [3] and m.attended == 3
+        assert not m.failed and m.attention.attended_list == [3] and m.attention.attended == 3
 
     def test_fails_when_color_filter_already_set(self):
         m, _ = run_both("scene_parse; set_color_attn(red); set_shape_attn(square); set_color_attn(blue)",
                         FILTER_SCENE)
-        assert m.failed and m.fail_index == 3 and "already set" in m.fail_reason
+        assert m.failed and m.control.fail_index == 3 and "already set" in m.fail_reason
 
     def test_forbidden_in_loop_body(self):
         m, _ = run_both(
             "scene_parse; loop_start; top_down_attend; next_object; set_color_attn(red); loop_end",
             FILTER_SCENE,
         )
-        assert m.failed and m.fail_index == 4 and "loop body" in m.fail_reason
+        assert m.failed and m.control.fail_index == 4 and "loop body" in m.fail_reason
 
 
 class TestResetAttn:
@@ -285,30 +305,30 @@ class TestResetAttn:
             FILTER_SCENE,
         )
         assert not m.failed
-        assert m.shape_filter is None and m.color_filter is None
-        assert m.stale and m.k == 0 and m.attended is None
+        assert m.attention.shape_filter < 0 and m.attention.color_filter < 0
+        assert m.attention.stale and m.attention.cursor == 0 and m.attention.attended < 0
 
     def test_attends_everything_after_reset(self):
         m, _ = run_both("scene_parse; set_shape_attn(circle); top_down_attend; reset_attn; top_down_attend",
                         FILTER_SCENE)
-        assert m.attended_list == [3, 2, 1, 0] and m.attended == 3
+        assert m.attention.attended_list == [3, 2, 1, 0] and m.attention.attended == 3
 
     def test_never_fails_without_filters(self):
         m, _ = run_both("scene_parse; reset_attn; reset_attn", FILTER_SCENE)
-        assert not m.failed and m.stale
+        assert not m.failed and m.attention.stale
 
     def test_forbidden_in_loop_body(self):
         m, _ = run_both("scene_parse; loop_start; top_down_attend; reset_attn; next_object; loop_end",
                         FILTER_SCENE)
-        assert m.failed and m.fail_index == 3 and "loop body" in m.fail_reason
+        assert m.failed and m.control.fail_index == 3 and "loop body" in m.fail_reason
 
 
 class TestTopDownAttend:
     def test_orders_by_distance_from_fovea(self):
         m, _ = run_both("scene_parse; top_down_attend", THREE)
         assert not m.failed
-        assert m.attended_list == [1, 2, 0] and not m.stale
-        assert m.attended == 1 and m.k == 0
+        assert m.attention.attended_list == [1, 2, 0] and not m.attention.stale
+        assert m.attention.attended == 1 and m.attention.cursor == 0
 
     def test_ties_broken_by_slot(self):
         sc = scene(
@@ -319,68 +339,68 @@ class TestTopDownAttend:
             obj("circle", "red", 0.5, 0.3),  # 4: distance .2
         )
         m, _ = run_both("scene_parse; top_down_attend", sc)
-        assert m.attended_list == [3, 0, 1, 2, 4]
+        assert m.attention.attended_list == [3, 0, 1, 2, 4]
 
     def test_orders_from_fovea_at_refresh_time(self):
         m, _ = run_both("scene_parse; fixate(left); top_down_attend", THREE)
-        assert m.attended_list == [0, 2, 1] and m.attended == 0
+        assert m.attention.attended_list == [0, 2, 1] and m.attention.attended == 0
         m, _ = run_both("scene_parse; fixate(right); top_down_attend", THREE)
-        assert m.attended_list == [1, 2, 0]
+        assert m.attention.attended_list == [1, 2, 0]
         m, _ = run_both("scene_parse; fixate(bottom); top_down_attend", THREE)
-        assert m.attended_list == [2, 1, 0]
+        assert m.attention.attended_list == [2, 1, 0]
 
     def test_refreshes_only_when_stale(self):
         m, _ = run_both("scene_parse; top_down_attend; fixate(left); top_down_attend", THREE)
-        assert m.attended_list == [1, 2, 0] and m.attended == 1  # not re-sorted from the left
+        assert m.attention.attended_list == [1, 2, 0] and m.attention.attended == 1  # not re-sorted from the left
         m, _ = run_both("scene_parse; top_down_attend; fixate(left); reset_attn; top_down_attend", THREE)
-        assert m.attended_list == [0, 2, 1] and m.attended == 0
+        assert m.attention.attended_list == [0, 2, 1] and m.attention.attended == 0
 
     def test_uses_current_object_positions(self):
         sc = scene(obj("square", "red", 0.5, 0.5), obj("circle", "blue", 0.7, 0.5))
         m, _ = run_both("scene_parse; grab_object; move_hand_left; top_down_attend", sc)
-        assert not m.failed and m.attended_list == [1, 0]
+        assert not m.failed and m.attention.attended_list == [1, 0]
         m, _ = run_both("scene_parse; top_down_attend", sc)
-        assert m.attended_list == [0, 1]
+        assert m.attention.attended_list == [0, 1]
 
     def test_attends_at_cursor(self):
         m, _ = run_both("scene_parse; next_object; top_down_attend", THREE)
-        assert m.k == 1 and m.attended == 2
+        assert m.attention.cursor == 1 and m.attention.attended == 2
         m, _ = run_both("scene_parse; next_object; next_object; top_down_attend", THREE)
-        assert m.k == 2 and m.attended == 0
+        assert m.attention.cursor == 2 and m.attention.attended == 0
 
     def test_fails_when_cursor_reaches_end(self):
         m, _ = run_both("scene_parse; next_object; next_object; next_object; top_down_attend", THREE)
-        assert m.failed and m.fail_index == 4 and "cursor" in m.fail_reason
+        assert m.failed and m.control.fail_index == 4 and "cursor" in m.fail_reason
 
     def test_fails_on_empty_scene(self):
         m, _ = run_both("scene_parse; top_down_attend", scene())
-        assert m.failed and m.fail_index == 1
+        assert m.failed and m.control.fail_index == 1
 
     def test_skips_removed_objects(self):
         m, _ = run_both("scene_parse; top_down_attend; remove_from_imagine_buffer; top_down_attend", THREE)
-        assert not m.failed and m.attended_list == [2, 0] and m.attended == 2
+        assert not m.failed and m.attention.attended_list == [2, 0] and m.attention.attended == 2
 
 
 class TestNextObject:
     def test_advances_cursor_and_clears_attended(self):
         m, _ = run_both("scene_parse; top_down_attend; next_object", THREE)
-        assert not m.failed and m.k == 1 and m.attended is None
+        assert not m.failed and m.attention.cursor == 1 and m.attention.attended < 0
 
     def test_refreshes_a_stale_list(self):
         m, _ = run_both("scene_parse; fixate(left); next_object", THREE)
-        assert not m.stale and m.attended_list == [0, 2, 1] and m.k == 1
+        assert not m.attention.stale and m.attention.attended_list == [0, 2, 1] and m.attention.cursor == 1
 
     def test_cursor_may_equal_list_length(self):
         m, _ = run_both("scene_parse; next_object; next_object; next_object", THREE)
-        assert not m.failed and m.k == 3 == len(m.attended_list)
+        assert not m.failed and m.attention.cursor == 3 == len(m.attention.attended_list)
 
     def test_fails_past_the_end(self):
         m, _ = run_both("scene_parse; next_object; next_object; next_object; next_object", THREE)
-        assert m.failed and m.fail_index == 4 and "beyond" in m.fail_reason
+        assert m.failed and m.control.fail_index == 4 and "beyond" in m.fail_reason
 
     def test_fails_on_empty_list(self):
         m, _ = run_both("scene_parse; next_object", scene())
-        assert m.failed and m.fail_index == 1
+        assert m.failed and m.control.fail_index == 1
 
 
 class TestAttendPointer:
@@ -388,27 +408,27 @@ class TestAttendPointer:
 
     def test_attends_object_under_pointer(self):
         m, _ = run_both("scene_parse; attend_pointer", self.SC)
-        assert not m.failed and m.attended == 1
-        assert m.stale and m.k == 0  # A and k untouched
+        assert not m.failed and m.attention.attended == 1
+        assert m.attention.stale and m.attention.cursor == 0  # A and k untouched
 
     def test_does_not_touch_list_or_cursor(self):
         m, _ = run_both("scene_parse; top_down_attend; next_object; attend_pointer", self.SC)
-        assert not m.failed and m.attended == 1
-        assert m.k == 1 and m.attended_list == [1, 0] and not m.stale
+        assert not m.failed and m.attention.attended == 1
+        assert m.attention.cursor == 1 and m.attention.attended_list == [1, 0] and not m.attention.stale
 
     def test_fails_without_pointer(self):
         sc = scene(obj("circle", "blue", 0.5, 0.5))
         m, _ = run_both("scene_parse; attend_pointer", sc)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "no pointer"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "no pointer"
 
     def test_fails_when_nothing_under_pointer(self):
         sc = scene(obj("circle", "blue", 0.7, 0.6), pointer=(0.3, 0.3))
         m, _ = run_both("scene_parse; attend_pointer", sc)
-        assert m.failed and m.fail_index == 1 and "under the pointer" in m.fail_reason
+        assert m.failed and m.control.fail_index == 1 and "under the pointer" in m.fail_reason
 
     def test_fails_when_object_under_pointer_was_removed(self):
         m, _ = run_both("scene_parse; attend_pointer; remove_from_imagine_buffer; attend_pointer", self.SC)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
 
 # =========================================================================================
@@ -423,17 +443,18 @@ class TestFixate:
     def test_targets(self, target, expected):
         m, _ = run_both(f"scene_parse; fixate({target})", THREE)
         assert not m.failed
-        assert m.fovea == expected and m.history == [CENTRE, expected] and m.h == 1
+        assert m.fovea.position == expected and m.fovea.history == [CENTRE, expected] and m.fovea.history_index == 1
 
     def test_appends_to_history(self):
         m, _ = run_both("scene_parse; fixate(left); fixate(top); fixate(left)", THREE)
-        assert m.history == [CENTRE, (0, C), (C, 0), (0, C)] and m.h == 3 and m.fovea == (0, C)
+        f = m.fovea
+        assert f.history == [CENTRE, (0, C), (C, 0), (0, C)] and f.history_index == 3 and f.position == (0, C)
 
     def test_history_holds_hist_max_fixations(self):
         assert CFG.hist_max == 32
         targets = [FIXATE_TARGETS[i % 4] for i in range(CFG.hist_max - 1)]
         m, _ = run_both("scene_parse; " + "; ".join(f"fixate({t})" for t in targets), THREE)
-        assert not m.failed and len(m.history) == CFG.hist_max and m.h == CFG.hist_max - 1
+        assert not m.failed and len(m.fovea.history) == CFG.hist_max and m.fovea.history_index == CFG.hist_max - 1
 
     @pytest.mark.parametrize("last", ["fixate(bottom)", "fixate_attended_object", "fixate_pointer"])
     def test_fixation_beyond_hist_max_fails(self, last):
@@ -443,15 +464,15 @@ class TestFixate:
                    obj("diamond", "blue", 0.2, 0.8), obj("star", "yellow", 0.8, 0.8), pointer=(0.4, 0.6))
         body = "; ".join(["top_down_attend"] + ["fixate(left)"] * 7 + [last, "next_object"])
         m, _ = run_both(f"scene_parse; loop_start; {body}; loop_end", sc)
-        assert m.failed and m.fail_index == 10 and "history full" in m.fail_reason
-        assert len(m.history) == CFG.hist_max
+        assert m.failed and m.control.fail_index == 10 and "history full" in m.fail_reason
+        assert len(m.fovea.history) == CFG.hist_max
 
     def test_three_iterations_fit_the_history(self):
         sc = scene(obj("square", "red", 0.2, 0.2), obj("circle", "green", 0.8, 0.2),
                    obj("diamond", "blue", 0.2, 0.8))
         body = "; ".join(["top_down_attend"] + ["fixate(left)"] * 7 + ["fixate_attended_object", "next_object"])
         m, _ = run_both(f"scene_parse; loop_start; {body}; loop_end", sc)
-        assert not m.failed and len(m.history) == 25 and m.k == 3
+        assert not m.failed and len(m.fovea.history) == 25 and m.attention.cursor == 3
 
 
 class TestFixateAttendedObject:
@@ -459,72 +480,75 @@ class TestFixateAttendedObject:
         sc = scene(obj("triangle", "red", 0.3, 0.7), obj("circle", "blue", 0.9, 0.9))
         m, _ = run_both("scene_parse; top_down_attend; fixate_attended_object", sc)
         assert not m.failed
-        assert m.fovea == (u(0.3), u(0.7)) and m.history == [CENTRE, (u(0.3), u(0.7))] and m.h == 1
+        f = m.fovea
+        assert f.position == (u(0.3), u(0.7)) and f.history == [CENTRE, (u(0.3), u(0.7))] and f.history_index == 1
 
     def test_follows_moved_object(self):
         m, _ = run_both("scene_parse; grab_object; move_hand_up; top_down_attend; fixate_attended_object",
                         CENTRED)
-        assert not m.failed and m.fovea == centre_of(m, 0) and m.fovea[1] < C
+        assert not m.failed and m.fovea.position == centre_of(m, 0) and m.fovea.position[1] < C
 
     def test_fails_without_attended_object(self):
         m, _ = run_both("scene_parse; fixate_attended_object", THREE)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "no attended object"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "no attended object"
 
     def test_fails_after_next_object(self):
         m, _ = run_both("scene_parse; top_down_attend; next_object; fixate_attended_object", THREE)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
 
 class TestFixatePointer:
     def test_fixates_pointer(self):
         sc = scene(obj("circle", "blue", 0.8, 0.8), pointer=(0.3, 0.7))
         m, _ = run_both("scene_parse; fixate_pointer", sc)
-        assert not m.failed and m.fovea == (u(0.3), u(0.7)) and m.history[-1] == m.fovea and m.h == 1
+        f = m.fovea
+        assert not m.failed and f.position == (u(0.3), u(0.7)) and f.history[-1] == f.position and f.history_index == 1
 
     def test_fails_without_pointer(self):
         m, _ = run_both("scene_parse; fixate_pointer", THREE)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "no pointer"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "no pointer"
 
 
 class TestFixatePrevious:
     def test_walks_back_without_changing_history(self):
         m, _ = run_both("scene_parse; fixate(left); fixate(top); fixate_previous", THREE)
-        assert not m.failed and m.fovea == (0, C) and m.h == 1
-        assert m.history == [CENTRE, (0, C), (C, 0)]
+        assert not m.failed and m.fovea.position == (0, C) and m.fovea.history_index == 1
+        assert m.fovea.history == [CENTRE, (0, C), (C, 0)]
         m, _ = run_both("scene_parse; fixate(left); fixate(top); fixate_previous; fixate_previous", THREE)
-        assert m.fovea == CENTRE and m.h == 0 and len(m.history) == 3
+        assert m.fovea.position == CENTRE and m.fovea.history_index == 0 and len(m.fovea.history) == 3
 
     def test_fails_at_start_of_history(self):
         m, _ = run_both("scene_parse; fixate_previous", THREE)
-        assert m.failed and m.fail_index == 1 and "previous" in m.fail_reason
+        assert m.failed and m.control.fail_index == 1 and "previous" in m.fail_reason
         m, _ = run_both("scene_parse; fixate(left); fixate_previous; fixate_previous", THREE)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
     def test_new_fixation_after_walking_back_appends(self):
         m, _ = run_both("scene_parse; fixate(left); fixate(right); fixate_previous; fixate_previous; "
                         "fixate(top)", THREE)
-        assert m.history == [CENTRE, (0, C), (U, C), (C, 0)] and m.h == 3 and m.fovea == (C, 0)
+        f = m.fovea
+        assert f.history == [CENTRE, (0, C), (U, C), (C, 0)] and f.history_index == 3 and f.position == (C, 0)
 
     def test_attention_refresh_uses_restored_fovea(self):
         m, _ = run_both("scene_parse; fixate(left); fixate(right); fixate_previous; top_down_attend", THREE)
-        assert m.fovea == (0, C) and m.attended_list == [0, 2, 1]
+        assert m.fovea.position == (0, C) and m.attention.attended_list == [0, 2, 1]
 
 
 class TestFixateNext:
     def test_walks_forward_without_changing_history(self):
         m, _ = run_both("scene_parse; fixate(left); fixate(top); fixate_previous; fixate_previous; "
                         "fixate_next", THREE)
-        assert not m.failed and m.fovea == (0, C) and m.h == 1
-        assert m.history == [CENTRE, (0, C), (C, 0)]
+        assert not m.failed and m.fovea.position == (0, C) and m.fovea.history_index == 1
+        assert m.fovea.history == [CENTRE, (0, C), (C, 0)]
         m, _ = run_both("scene_parse; fixate(left); fixate(top); fixate_previous; fixate_previous; "
                         "fixate_next; fixate_next", THREE)
-        assert m.fovea == (C, 0) and m.h == 2 and len(m.history) == 3
+        assert m.fovea.position == (C, 0) and m.fovea.history_index == 2 and len(m.fovea.history) == 3
 
     def test_fails_at_end_of_history(self):
         m, _ = run_both("scene_parse; fixate_next", THREE)
-        assert m.failed and m.fail_index == 1 and "next" in m.fail_reason
+        assert m.failed and m.control.fail_index == 1 and "next" in m.fail_reason
         m, _ = run_both("scene_parse; fixate(left); fixate_previous; fixate_next; fixate_next", THREE)
-        assert m.failed and m.fail_index == 4
+        assert m.failed and m.control.fail_index == 4
 
 
 # =========================================================================================
@@ -534,27 +558,27 @@ class TestMoveHandToAttendedObject:
     def test_moves_empty_hand_to_attended_centre(self):
         sc = scene(obj("triangle", "red", 0.3, 0.7), obj("circle", "blue", 0.9, 0.9))
         m, _ = run_both("scene_parse; top_down_attend; move_hand_to_attended_object", sc)
-        assert not m.failed and m.hand == (u(0.3), u(0.7)) and m.held is None
+        assert not m.failed and m.hand.position == (u(0.3), u(0.7)) and m.hand.held < 0
         assert centre_of(m, 0) == (u(0.3), u(0.7))  # nothing moved
 
     def test_fails_without_attended_object(self):
         m, _ = run_both("scene_parse; move_hand_to_attended_object", THREE)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "no attended object"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "no attended object"
 
     def test_fails_when_attended_is_held(self):
         m, _ = run_both("scene_parse; top_down_attend; move_hand_to_attended_object; grab_object; "
                         "move_hand_to_attended_object", THREE)
-        assert m.failed and m.fail_index == 4 and "held" in m.fail_reason
+        assert m.failed and m.control.fail_index == 4 and "held" in m.fail_reason
 
     def test_carries_held_object_until_contact_horizontally(self):
         sc = scene(obj("square", "red", 0.25, 0.5), obj("circle", "blue", 0.8, 0.5))
         m, _ = run_both("scene_parse; top_down_attend; move_hand_to_attended_object; grab_object; "
                         "next_object; top_down_attend; move_hand_to_attended_object", sc)
-        assert not m.failed and m.held == 0 and m.attended == 1
+        assert not m.failed and m.hand.held == 0 and m.attention.attended == 1
         x, y = centre_of(m, 0)
         assert y == u(0.5) and u(0.25) < x < u(0.8)
         assert centre_of(m, 1) == (u(0.8), u(0.5))  # the target does not move
-        assert m.hand == (x, y)  # the hand keeps its place on the object
+        assert m.hand.position == (x, y)  # the hand keeps its place on the object
         assert_no_overlap(m)
         assert_in_contact(m, 0, [(1, 0)])
         # adjacent: the masks are at most a pixel apart, about a width apart in centres
@@ -570,7 +594,7 @@ class TestMoveHandToAttendedObject:
         assert (x1, y1) == (u(0.75), u(0.75))
         assert np.hypot(x1 - x0, y1 - y0) < before / 3
         assert x0 - u(0.25) == y0 - u(0.25)  # straight along the diagonal
-        assert m.hand == (x0, y0)
+        assert m.hand.position == (x0, y0)
         assert_no_overlap(m)
         assert_in_contact(m, 0, [(1, 0), (0, 1), (1, 1)])
 
@@ -579,50 +603,50 @@ class TestGrabObject:
     def test_grabs_object_under_hand(self):
         sc = scene(obj("circle", "blue", 0.2, 0.8), obj("square", "red", 0.52, 0.48))
         m, _ = run_both("scene_parse; grab_object", sc)
-        assert not m.failed and m.held == 1
-        assert m.attended is None  # grabbing does not attend
+        assert not m.failed and m.hand.held == 1
+        assert m.attention.attended < 0  # grabbing does not attend
 
     def test_grabs_attended_object_after_moving_hand(self):
         sc = scene(obj("star", "yellow", 0.31, 0.67, 0.05), obj("circle", "blue", 0.8, 0.2))
         m, _ = run_both("scene_parse; top_down_attend; move_hand_to_attended_object; grab_object", sc)
-        assert not m.failed and m.attended == 0 and m.held == 0  # the centre pixel is in the mask
+        assert not m.failed and m.attention.attended == 0 and m.hand.held == 0  # the centre pixel is in the mask
 
     def test_fails_when_nothing_under_hand(self):
         m, _ = run_both("scene_parse; grab_object", THREE)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "no object at the hand"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "no object at the hand"
 
     def test_fails_when_already_holding(self):
         m, _ = run_both("scene_parse; grab_object; grab_object", CENTRED)
-        assert m.failed and m.fail_index == 2 and "already holding" in m.fail_reason
+        assert m.failed and m.control.fail_index == 2 and "already holding" in m.fail_reason
 
     def test_fails_on_removed_object(self):
         m, _ = run_both("scene_parse; top_down_attend; remove_from_imagine_buffer; grab_object", CENTRED)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
     def test_never_grabs_imagined_object(self):
         # the hand is at the centre, inside the imagined circle; no real object there
         sc = scene(obj("square", "red", 0.1, 0.1))
         m, _ = run_both("scene_parse; imagine_object(circle); grab_object", sc)
-        assert m.failed and m.fail_index == 2
+        assert m.failed and m.control.fail_index == 2
 
 
 class TestReleaseObject:
     def test_releases_in_place(self):
         m, _ = run_both("scene_parse; grab_object; move_hand_right; release_object", CENTRED)
-        assert not m.failed and m.held is None
-        assert m.hand == centre_of(m, 0) and m.objects[0].x > C
+        assert not m.failed and m.hand.held < 0
+        assert m.hand.position == centre_of(m, 0) and slot(m, 0).x > C
 
     def test_fails_when_not_holding(self):
         m, _ = run_both("scene_parse; release_object", CENTRED)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "not holding an object"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "not holding an object"
 
     def test_released_object_is_no_longer_carried(self):
         m, _ = run_both("scene_parse; grab_object; release_object; move_hand_left", CENTRED)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
     def test_can_grab_again_after_release(self):
         m, _ = run_both("scene_parse; grab_object; release_object; grab_object", CENTRED)
-        assert not m.failed and m.held == 0
+        assert not m.failed and m.hand.held == 0
 
 
 # =========================================================================================
@@ -643,22 +667,22 @@ class TestMoveHandDirection:
         w = 0.1
         sc = scene(obj(shape, "red", 0.5, 0.5, w))
         m, _ = run_both(f"scene_parse; grab_object; move_hand_{direction}", sc)
-        assert not m.failed and m.held == 0
-        o = m.objects[0]
+        assert not m.failed and m.hand.held == 0
+        o = slot(m, 0)
         x, y = o.x / U, o.y / U
         # the w x w box stays in the workspace, and one more pixel would take it out
         edge = {"left": x - w / 2, "right": 1 - (x + w / 2), "up": y - w / 2, "down": 1 - (y + w / 2)}
         assert 0 <= edge[direction] < PIXEL
         assert (x, y)[direction in ("left", "right")] == 0.5  # it moved along one axis only
         m.output_scene().validate()
-        assert m.hand == (o.x, o.y)  # the hand moved with the object
+        assert m.hand.position == (o.x, o.y)  # the hand moved with the object
         # the displacement is whole pixels
         assert (o.x - C) % SUB == 0 and (o.y - C) % SUB == 0
 
     @pytest.mark.parametrize("direction", list(DIRECTIONS))
     def test_fails_when_not_holding(self, direction):
         m, _ = run_both(f"scene_parse; move_hand_{direction}", CENTRED)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "not holding an object"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "not holding an object"
 
     @pytest.mark.parametrize("direction", list(DIRECTIONS))
     def test_stops_at_contact_with_object(self, direction):
@@ -670,7 +694,7 @@ class TestMoveHandDirection:
         assert (x - C) * step[0] > 0 or (y - C) * step[1] > 0  # it moved toward the blocker
         assert (x - C) * step[1] == 0 and (y - C) * step[0] == 0  # only along the direction
         assert centre_of(m, 1) == (u(bx), u(by))
-        assert m.hand == (x, y)
+        assert m.hand.position == (x, y)
         assert_no_overlap(m)
         assert_in_contact(m, 0, [step])
 
@@ -690,7 +714,7 @@ class TestMoveHandDirection:
         sc = scene(obj("square", "red", 0.5, start))
         m, _ = run_both("scene_parse; imagine_object(hline); top_down_attend; move_hand_to_attended_object; "
                         f"grab_object; move_hand_{direction}", sc)
-        assert not m.failed and m.imagined == (IMAGINE_KINDS.index("hline"), C, C)
+        assert not m.failed and imagined(m) == (IMAGINE_KINDS.index("hline"), C, C)
         x, y = centre_of(m, 0)
         assert x == C and (y > u(start) if direction == "down" else y < u(start))
         rows = set(imagined_pixels(1, C, C, CFG)[0].tolist())
@@ -718,7 +742,7 @@ class TestMoveHandDirection:
         assert abs((x / U - 0.05) - 0.75) <= 2 * PIXEL  # left edge at the circle's rim
         assert_in_contact(m, 0, [(-1, 0)])
         m, _ = run_both(prog + "; reset_imagination; move_hand_left", sc)
-        assert not m.failed and m.imagined is None and box_gap(m, 0, "left") < PIXEL
+        assert not m.failed and m.blackboard.imagined_kind < 0 and box_gap(m, 0, "left") < PIXEL
 
 
 # =========================================================================================
@@ -730,17 +754,17 @@ class TestMoveHandToPointer:
         sc = scene(obj("square", "red", 0.5, 0.5), pointer=pointer)
         m, _ = run_both("scene_parse; grab_object; move_hand_to_pointer", sc)
         assert not m.failed
-        o = m.objects[0]
+        o = slot(m, 0)
         assert abs(o.x / U - pointer[0]) <= PIXEL / 2 and abs(o.y / U - pointer[1]) <= PIXEL / 2
-        assert m.hand == (o.x, o.y)
+        assert m.hand.position == (o.x, o.y)
 
     def test_hand_keeps_its_place_on_the_object(self):
         sc = scene(obj("square", "red", 0.52, 0.49), pointer=(0.3, 0.3))
         m, _ = run_both("scene_parse; grab_object; move_hand_to_pointer", sc)
         assert not m.failed
-        o = m.objects[0]
+        o = slot(m, 0)
         assert abs(o.x / U - 0.3) <= PIXEL / 2 and abs(o.y / U - 0.3) <= PIXEL / 2
-        assert (m.hand[0] - o.x, m.hand[1] - o.y) == (C - u(0.52), C - u(0.49))
+        assert (m.hand.position[0] - o.x, m.hand.position[1] - o.y) == (C - u(0.52), C - u(0.49))
 
     def test_stops_at_contact_on_the_way(self):
         sc = scene(obj("square", "red", 0.5, 0.5), obj("circle", "blue", 0.3, 0.5), pointer=(0.12, 0.5))
@@ -754,17 +778,17 @@ class TestMoveHandToPointer:
     def test_stops_at_workspace_edge(self):
         sc = scene(obj("square", "red", 0.5, 0.5), pointer=(0.0, 0.5))
         m, _ = run_both("scene_parse; grab_object; move_hand_to_pointer", sc)
-        assert not m.failed and 0 <= m.objects[0].x / U - 0.05 < PIXEL and m.objects[0].y == C
+        assert not m.failed and 0 <= slot(m, 0).x / U - 0.05 < PIXEL and slot(m, 0).y == C
         m.output_scene().validate()
 
     def test_fails_when_not_holding(self):
         sc = scene(obj("square", "red", 0.5, 0.5), pointer=(0.3, 0.3))
         m, _ = run_both("scene_parse; move_hand_to_pointer", sc)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "not holding an object"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "not holding an object"
 
     def test_fails_without_pointer(self):
         m, _ = run_both("scene_parse; grab_object; move_hand_to_pointer", CENTRED)
-        assert m.failed and m.fail_index == 2 and m.fail_reason == "no pointer"
+        assert m.failed and m.control.fail_index == 2 and m.fail_reason == "no pointer"
 
 
 class TestMoveHandToFixateCollision:
@@ -773,28 +797,28 @@ class TestMoveHandToFixateCollision:
         sc = scene(obj("square", "red", 0.5, 0.5), pointer=pointer)
         m, _ = run_both("scene_parse; fixate_pointer; grab_object; move_hand_to_fixate_collision", sc)
         assert not m.failed
-        o = m.objects[0]
+        o = slot(m, 0)
         assert abs(o.x / U - pointer[0]) <= PIXEL / 2 and abs(o.y / U - pointer[1]) <= PIXEL / 2
-        assert m.hand == (o.x, o.y) and m.fovea == (u(pointer[0]), u(pointer[1]))
+        assert m.hand.position == (o.x, o.y) and m.fovea.position == (u(pointer[0]), u(pointer[1]))
 
     def test_uses_fovea_restored_by_fixate_previous(self):
         sc = scene(obj("square", "red", 0.5, 0.5), pointer=(0.7, 0.25))
         m, _ = run_both("scene_parse; fixate_pointer; fixate(bottom); fixate_previous; grab_object; "
                         "move_hand_to_fixate_collision", sc)
-        o = m.objects[0]
+        o = slot(m, 0)
         assert abs(o.x / U - 0.7) <= PIXEL / 2 and abs(o.y / U - 0.25) <= PIXEL / 2
 
     def test_stops_at_workspace_edge(self):
         m, _ = run_both("scene_parse; fixate(left); grab_object; move_hand_to_fixate_collision", CENTRED)
-        assert not m.failed and 0 <= m.objects[0].x / U - m.objects[0].width / 2 < PIXEL
-        assert m.objects[0].y == C
+        assert not m.failed and 0 <= slot(m, 0).x / U - slot(m, 0).width / 2 < PIXEL
+        assert slot(m, 0).y == C
         m.output_scene().validate()
 
     def test_stops_at_contact_with_fixated_object(self):
         sc = scene(obj("square", "red", 0.5, 0.5), obj("triangle", "blue", 0.2, 0.8))
         m, _ = run_both("scene_parse; set_color_attn(blue); top_down_attend; fixate_attended_object; "
                         "grab_object; move_hand_to_fixate_collision", sc)
-        assert not m.failed and m.held == 0
+        assert not m.failed and m.hand.held == 0
         x, y = centre_of(m, 0)
         assert x < C and y > C
         assert_no_overlap(m)
@@ -802,7 +826,7 @@ class TestMoveHandToFixateCollision:
 
     def test_fails_when_not_holding(self):
         m, _ = run_both("scene_parse; fixate(left); move_hand_to_fixate_collision", CENTRED)
-        assert m.failed and m.fail_index == 2 and m.fail_reason == "not holding an object"
+        assert m.failed and m.control.fail_index == 2 and m.fail_reason == "not holding an object"
 
 
 # =========================================================================================
@@ -813,24 +837,24 @@ class TestFillColor:
     def test_colors_attended_object(self, color):
         m, _ = run_both(f"scene_parse; top_down_attend; fill_color({color})", THREE)
         assert not m.failed
-        assert [o.color for o in m.objects] == [color_id("red"), color_id(color), color_id("blue")]
+        assert colors(m) == [color_id("red"), color_id(color), color_id("blue")]
         assert m.output_scene().objects[1].color == color
 
     def test_fails_without_attended_object(self):
         m, _ = run_both("scene_parse; fill_color(red)", THREE)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "no attended object"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "no attended object"
 
     def test_fails_after_next_object(self):
         m, _ = run_both("scene_parse; top_down_attend; next_object; fill_color(red)", THREE)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
 
 class TestRemoveFromImagineBuffer:
     def test_removes_attended_object(self):
         m, _ = run_both("scene_parse; top_down_attend; remove_from_imagine_buffer", THREE)
         assert not m.failed
-        assert alive_ids(m) == [0, 2] and not m.objects[1].alive
-        assert m.attended is None and m.stale
+        assert alive_ids(m) == [0, 2] and not slot(m, 1).alive
+        assert m.attention.attended < 0 and m.attention.stale
         out = m.output_scene().objects
         assert len(out) == 2 and all(o.shape != "circle" for o in out)
 
@@ -838,81 +862,81 @@ class TestRemoveFromImagineBuffer:
         m, _ = run_both("scene_parse; top_down_attend; remove_from_imagine_buffer", CENTRED)
         assert not m.failed
         m, _ = run_both("scene_parse; grab_object; top_down_attend; remove_from_imagine_buffer", CENTRED)
-        assert not m.failed and m.held is None and m.output_scene().objects == ()
+        assert not m.failed and m.hand.held < 0 and m.output_scene().objects == ()
         m, _ = run_both("scene_parse; grab_object; top_down_attend; remove_from_imagine_buffer; "
                         "release_object", CENTRED)
-        assert m.failed and m.fail_index == 4
+        assert m.failed and m.control.fail_index == 4
 
     def test_removing_another_object_keeps_hold(self):
         sc = scene(obj("square", "red", 0.5, 0.5), obj("circle", "blue", 0.7, 0.5))
         m, _ = run_both("scene_parse; grab_object; next_object; top_down_attend; remove_from_imagine_buffer",
                         sc)
-        assert not m.failed and m.held == 0 and alive_ids(m) == [0]
+        assert not m.failed and m.hand.held == 0 and alive_ids(m) == [0]
 
     def test_fails_without_attended_object(self):
         m, _ = run_both("scene_parse; remove_from_imagine_buffer", THREE)
-        assert m.failed and m.fail_index == 1 and m.fail_reason == "no attended object"
+        assert m.failed and m.control.fail_index == 1 and m.fail_reason == "no attended object"
 
     def test_fails_twice_in_a_row(self):
         m, _ = run_both("scene_parse; top_down_attend; remove_from_imagine_buffer; remove_from_imagine_buffer",
                         THREE)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
 
 class TestImagineObject:
     def test_imagines_circle_at_fovea(self):
         sc = scene(obj("square", "red", 0.1, 0.1), obj("circle", "blue", 0.9, 0.9))
         m, _ = run_both("scene_parse; imagine_object(circle)", sc)
-        assert not m.failed and m.imagined == (IMAGINE_KINDS.index("circle"), C, C)
+        assert not m.failed and imagined(m) == (IMAGINE_KINDS.index("circle"), C, C)
         assert len(m.output_scene().objects) == 2  # never in the output
 
     def test_imagines_hline_at_fovea(self):
         sc = scene(obj("square", "red", 0.1, 0.5), obj("circle", "blue", 0.9, 0.9))
         m, _ = run_both("scene_parse; fixate(top); imagine_object(hline)", sc)
-        assert not m.failed and m.imagined == (IMAGINE_KINDS.index("hline"), C, 0)
+        assert not m.failed and imagined(m) == (IMAGINE_KINDS.index("hline"), C, 0)
 
     def test_imagined_object_is_never_attended(self):
         sc = scene(obj("square", "red", 0.1, 0.1))
         m, _ = run_both("scene_parse; imagine_object(circle); next_object", sc)
-        assert not m.failed and m.attended_list == [0]
+        assert not m.failed and m.attention.attended_list == [0]
         m, _ = run_both("scene_parse; imagine_object(circle); top_down_attend", scene())
-        assert m.failed and m.fail_index == 2
+        assert m.failed and m.control.fail_index == 2
 
     def test_fails_when_circle_overlaps_object(self):
         sc = scene(obj("square", "red", 0.5, 0.7))
         m, _ = run_both("scene_parse; imagine_object(circle)", sc)
-        assert m.failed and m.fail_index == 1 and "overlap" in m.fail_reason
+        assert m.failed and m.control.fail_index == 1 and "overlap" in m.fail_reason
 
     def test_fails_when_hline_crosses_object(self):
         sc = scene(obj("square", "red", 0.05, 0.5, 0.06))
         m, _ = run_both("scene_parse; imagine_object(hline)", sc)
-        assert m.failed and m.fail_index == 1 and "overlap" in m.fail_reason
+        assert m.failed and m.control.fail_index == 1 and "overlap" in m.fail_reason
         m, _ = run_both("scene_parse; fixate(top); imagine_object(hline)", sc)
         assert not m.failed  # the same object, the bar moved away
 
     def test_fails_when_one_exists(self):
         sc = scene(obj("square", "red", 0.1, 0.1))
         m, _ = run_both("scene_parse; imagine_object(circle); fixate(bottom); imagine_object(hline)", sc)
-        assert m.failed and m.fail_index == 3 and "exists" in m.fail_reason
+        assert m.failed and m.control.fail_index == 3 and "exists" in m.fail_reason
 
 
 class TestResetImagination:
     def test_deletes_imagined_object(self):
         sc = scene(obj("square", "red", 0.1, 0.1))
         m, _ = run_both("scene_parse; imagine_object(circle); reset_imagination", sc)
-        assert not m.failed and m.imagined is None
+        assert not m.failed and m.blackboard.imagined_kind < 0
 
     def test_allows_imagining_again(self):
         sc = scene(obj("square", "red", 0.1, 0.1))
         m, _ = run_both("scene_parse; imagine_object(circle); reset_imagination; imagine_object(hline)", sc)
-        assert not m.failed and m.imagined == (IMAGINE_KINDS.index("hline"), C, C)
+        assert not m.failed and imagined(m) == (IMAGINE_KINDS.index("hline"), C, C)
 
     def test_fails_when_none_exists(self):
         m, _ = run_both("scene_parse; reset_imagination", THREE)
-        assert m.failed and m.fail_index == 1 and "no imagined" in m.fail_reason
+        assert m.failed and m.control.fail_index == 1 and "no imagined" in m.fail_reason
         sc = scene(obj("square", "red", 0.1, 0.1))
         m, _ = run_both("scene_parse; imagine_object(circle); reset_imagination; reset_imagination", sc)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
 
 # =========================================================================================
@@ -929,44 +953,44 @@ ORIGINAL_COLORS = [color_id("red"), color_id("green"), color_id("blue")]
 class TestLoops:
     def test_loop_start_refreshes_attended_list(self):
         m, _ = run_both("scene_parse; fixate(left); loop_start", LOOP_SCENE)
-        assert not m.failed and not m.stale and m.attended_list == [0, 2, 1]
-        assert m.k == 0 and m.in_loop
+        assert not m.failed and not m.attention.stale and m.attention.attended_list == [0, 2, 1]
+        assert m.attention.cursor == 0 and m.control.in_loop
 
     def test_loop_start_keeps_a_fresh_list(self):
         m, _ = run_both("scene_parse; top_down_attend; fixate(left); loop_start", LOOP_SCENE)
-        assert m.attended_list == [1, 2, 0]
+        assert m.attention.attended_list == [1, 2, 0]
 
     def test_first_iteration_runs_eagerly(self):
         m, _ = run_both("scene_parse; loop_start; top_down_attend; fill_color(yellow)", LOOP_SCENE)
-        assert not m.failed and m.attended == 1
-        assert [o.color for o in m.objects] == [color_id("red"), color_id("yellow"), color_id("blue")]
+        assert not m.failed and m.attention.attended == 1
+        assert colors(m) == [color_id("red"), color_id("yellow"), color_id("blue")]
 
     def test_loop_end_replays_over_all_attended_objects(self):
         m, _ = run_both("scene_parse; loop_start; top_down_attend; fill_color(yellow); next_object; loop_end",
                         LOOP_SCENE)
-        assert not m.failed and not m.in_loop
-        assert [o.color for o in m.objects] == [color_id("yellow")] * 3
-        assert m.k == 3 and m.attended is None
+        assert not m.failed and not m.control.in_loop
+        assert colors(m) == [color_id("yellow")] * 3
+        assert m.attention.cursor == 3 and m.attention.attended < 0
 
     def test_replay_visits_objects_in_attention_order(self):
         m, _ = run_both("scene_parse; loop_start; top_down_attend; fixate_attended_object; next_object; "
                         "loop_end", LOOP_SCENE)
         assert not m.failed
-        assert m.history == [CENTRE] + [centre_of(m, i) for i in (1, 2, 0)]
+        assert m.fovea.history == [CENTRE] + [centre_of(m, i) for i in (1, 2, 0)]
 
     def test_loop_over_filtered_objects(self):
         sc = scene(obj("square", "red", 0.2, 0.2), obj("circle", "blue", 0.6, 0.5),
                    obj("triangle", "red", 0.8, 0.8))
         m, _ = run_both("scene_parse; set_color_attn(red); loop_start; top_down_attend; fill_color(green); "
                         "next_object; loop_end", sc)
-        assert not m.failed and m.k == 2
-        assert [o.color for o in m.objects] == [color_id("green"), color_id("blue"), color_id("green")]
+        assert not m.failed and m.attention.cursor == 2
+        assert colors(m) == [color_id("green"), color_id("blue"), color_id("green")]
 
     def test_loop_starting_mid_list(self):
         m, _ = run_both("scene_parse; next_object; loop_start; top_down_attend; fill_color(yellow); "
                         "next_object; loop_end", LOOP_SCENE)
-        assert not m.failed and m.k == 3
-        assert [o.color for o in m.objects] == [color_id("yellow"), color_id("green"), color_id("yellow")]
+        assert not m.failed and m.attention.cursor == 3
+        assert colors(m) == [color_id("yellow"), color_id("green"), color_id("yellow")]
 
     def test_iterations_bounded_by_n_max(self):
         # n_max objects: the loop runs exactly n_max iterations (the most it may run)
@@ -974,38 +998,38 @@ class TestLoops:
                 for i in range(CFG.n_max)]
         m, _ = run_both("scene_parse; loop_start; top_down_attend; fill_color(blue); next_object; loop_end",
                         scene(*objs))
-        assert not m.failed and m.k == CFG.n_max
-        assert all(o.color == color_id("blue") for o in m.objects)
+        assert not m.failed and m.attention.cursor == CFG.n_max
+        assert all(c == color_id("blue") for c in colors(m))
 
     def test_body_advancing_twice_stops_when_cursor_reaches_end(self):
         sc = scene(*LOOP_SCENE.objects, obj("star", "yellow", 0.85, 0.15))
         m, _ = run_both("scene_parse; loop_start; top_down_attend; fill_color(red); next_object; next_object; "
                         "loop_end", sc)
         # A = [1, 2, 0, 3]: the body attends A[0] = 1 and A[2] = 0 only
-        assert not m.failed and m.k == 4 and m.attended_list == [1, 2, 0, 3]
-        assert [o.color for o in m.objects] == [color_id("red"), color_id("red"), color_id("blue"),
+        assert not m.failed and m.attention.cursor == 4 and m.attention.attended_list == [1, 2, 0, 3]
+        assert colors(m) == [color_id("red"), color_id("red"), color_id("blue"),
                                                 color_id("yellow")]
 
     def test_body_advancing_twice_fails_past_end_in_replay(self):
         m, _ = run_both("scene_parse; loop_start; top_down_attend; next_object; next_object; loop_end",
                         LOOP_SCENE)
-        assert m.failed and m.fail_index == 4  # the second next_object, during the replay
+        assert m.failed and m.control.fail_index == 4  # the second next_object, during the replay
 
     def test_failure_in_replay_reports_body_index(self):
         m, _ = run_both("scene_parse; loop_start; top_down_attend; move_hand_to_attended_object; grab_object; "
                         "next_object; loop_end", LOOP_SCENE)
-        assert m.failed and m.fail_index == 4 and "already holding" in m.fail_reason
+        assert m.failed and m.control.fail_index == 4 and "already holding" in m.fail_reason
 
     def test_failure_in_eager_iteration_reports_its_index(self):
         m, _ = run_both("scene_parse; loop_start; top_down_attend; release_object; next_object; loop_end",
                         LOOP_SCENE)
-        assert m.failed and m.fail_index == 3
+        assert m.failed and m.control.fail_index == 3
 
     def test_removal_in_body_shrinks_list(self):
         # next_object refreshes the list after each removal, so the cursor runs past its end
         m, _ = run_both("scene_parse; loop_start; top_down_attend; remove_from_imagine_buffer; next_object; "
                         "loop_end", LOOP_SCENE)
-        assert m.failed and m.fail_index == 4
+        assert m.failed and m.control.fail_index == 4
         assert alive_ids(m) == [2]  # removed 1 (eager), then 0 (farthest of the rest)
 
     @pytest.mark.parametrize("prefix", ["set_shape_attn(star)", "next_object; next_object; next_object"])
@@ -1013,57 +1037,57 @@ class TestLoops:
         n = len(prefix.split(";"))
         m, _ = run_both(f"scene_parse; {prefix}; loop_start; top_down_attend; release_object; fill_color(red); "
                         "fixate(left); next_object; loop_end", LOOP_SCENE)
-        assert not m.failed and not m.in_loop
-        assert [o.color for o in m.objects] == ORIGINAL_COLORS
-        assert m.history == [CENTRE] and m.k == (0 if n == 1 else 3)
-        assert m.attended is None
+        assert not m.failed and not m.control.in_loop
+        assert colors(m) == ORIGINAL_COLORS
+        assert m.fovea.history == [CENTRE] and m.attention.cursor == (0 if n == 1 else 3)
+        assert m.attention.attended < 0
 
     def test_zero_iteration_loop_still_rejects_forbidden_instruction(self):
         m, _ = run_both("scene_parse; set_shape_attn(star); loop_start; top_down_attend; reset_attn; "
                         "next_object; loop_end", LOOP_SCENE)
-        assert m.failed and m.fail_index == 4
+        assert m.failed and m.control.fail_index == 4
 
     def test_zero_iteration_loop_still_needs_required_instructions(self):
         m, _ = run_both("scene_parse; set_shape_attn(star); loop_start; top_down_attend; loop_end", LOOP_SCENE)
-        assert m.failed and m.fail_index == 4 and "lacks" in m.fail_reason
+        assert m.failed and m.control.fail_index == 4 and "lacks" in m.fail_reason
 
     @pytest.mark.parametrize("forbidden", ["set_shape_attn(circle)", "set_color_attn(red)", "reset_attn",
                                            "loop_start"])
     def test_forbidden_instruction_in_body_fails_where_it_stands(self, forbidden):
         m, _ = run_both(f"scene_parse; loop_start; top_down_attend; fill_color(yellow); {forbidden}; "
                         "next_object; loop_end", LOOP_SCENE)
-        assert m.failed and m.fail_index == 4 and "not allowed in a loop body" in m.fail_reason
-        assert m.shape_filter is None and m.color_filter is None
+        assert m.failed and m.control.fail_index == 4 and "not allowed in a loop body" in m.fail_reason
+        assert m.attention.shape_filter < 0 and m.attention.color_filter < 0
 
     @pytest.mark.parametrize("body, end", [("top_down_attend; fill_color(yellow)", 4),
                                            ("fixate(left); next_object", 4),
                                            ("fixate(left)", 3)])
     def test_body_lacking_required_instruction_fails_at_loop_end(self, body, end):
         m, _ = run_both(f"scene_parse; loop_start; {body}; loop_end", LOOP_SCENE)
-        assert m.failed and m.fail_index == end and "lacks" in m.fail_reason
+        assert m.failed and m.control.fail_index == end and "lacks" in m.fail_reason
 
     def test_loop_end_without_loop_start_fails(self):
         m, _ = run_both("scene_parse; loop_end", LOOP_SCENE)
-        assert m.failed and m.fail_index == 1 and "without loop_start" in m.fail_reason
+        assert m.failed and m.control.fail_index == 1 and "without loop_start" in m.fail_reason
         m, _ = run_both("scene_parse; loop_start; top_down_attend; next_object; loop_end; loop_end",
                         LOOP_SCENE)
-        assert m.failed and m.fail_index == 5
+        assert m.failed and m.control.fail_index == 5
 
     def test_two_loops_in_sequence(self):
         m, _ = run_both("scene_parse; set_shape_attn(circle); loop_start; top_down_attend; fill_color(red); "
                         "next_object; loop_end; reset_attn; loop_start; top_down_attend; fixate_attended_object; "
                         "next_object; loop_end", LOOP_SCENE)
-        assert not m.failed and m.k == 3 and len(m.history) == 4
-        assert m.objects[1].color == color_id("red")
+        assert not m.failed and m.attention.cursor == 3 and len(m.fovea.history) == 4
+        assert slot(m, 1).color == color_id("red")
 
     def test_body_of_body_max_instructions_runs(self):
         assert CFG.body_max == 24
         body = ["top_down_attend"] + ["fill_color(yellow)"] * (CFG.body_max - 2) + ["next_object"]
         m, _ = run_both("scene_parse; loop_start; " + "; ".join(body) + "; loop_end", LOOP_SCENE)
-        assert not m.failed and m.k == 3
-        assert all(o.color == color_id("yellow") for o in m.objects)
+        assert not m.failed and m.attention.cursor == 3
+        assert all(c == color_id("yellow") for c in colors(m))
 
     def test_body_longer_than_body_max_fails(self):
         body = ["top_down_attend"] + ["fill_color(yellow)"] * (CFG.body_max - 1) + ["next_object"]
         m, _ = run_both("scene_parse; loop_start; " + "; ".join(body) + "; loop_end", LOOP_SCENE)
-        assert m.failed and m.fail_index == 2 + CFG.body_max and "body_max" in m.fail_reason
+        assert m.failed and m.control.fail_index == 2 + CFG.body_max and "body_max" in m.fail_reason

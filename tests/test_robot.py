@@ -162,6 +162,57 @@ def test_robot_cli_errors_are_one_line(capsys):
         assert err.startswith("vcc: error: ") and message in err and err.count("\n") == 1, err
 
 
+def test_run_reads_a_long_program_as_text_a_file_as_a_file_and_refuses_a_missing_file(tmp_path, capsys):
+    """`--program` given a long program's text (once an OSError: file name too long), an
+    existing file, and a .vcc file that is not there; no MuJoCo runs."""
+    import argparse
+    import os
+
+    from robot.cli import _program
+    from vcc.cli import main
+
+    steps = ["scene_parse", "set_color_attn(red)", "top_down_attend", "move_hand_to_attended_object", "grab_object",
+             "move_hand_left", "release_object"]
+    text = "; ".join(steps + steps[1:] * 6)
+    assert len(text) >= 400
+    args = argparse.Namespace(program=text, concept="x", induced=None)
+    got = _program(args)
+    assert got == parse(text) and len(got) == len(steps) + 6 * (len(steps) - 1)
+    short = "scene_parse; top_down_attend; fill_color(blue)"
+    for name in ("p", "p.vcc"):
+        (tmp_path / name).write_text(short + "\n")
+        assert _program(argparse.Namespace(program=str(tmp_path / name), concept="x", induced=None)) == parse(short)
+    cores = os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else None
+    missing = tmp_path / "none.vcc"
+    assert main(["robot", "run", "--concept", "x", "--program", str(missing)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"vcc: error: {missing}: no such program file\n"
+    assert not missing.exists()
+    if cores is not None:  # refused before the process was set up (pinned to one core) for MJX
+        assert os.sched_getaffinity(0) == cores
+
+
+def test_importing_mjx_does_not_print_that_the_optional_warp_is_missing():
+    import importlib.util
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from robot import _without_warp_absent
+
+    code = "import robot.control, mujoco.mjx.warp as w; print('warp installed:', w.WARP_INSTALLED)"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                       cwd=Path(__file__).parent.parent)
+    assert r.returncode == 0, r.stderr
+    have_warp = importlib.util.find_spec("warp") is not None
+    assert r.stdout == f"warp installed: {have_warp}\n" and "Failed to import" not in r.stderr, (r.stdout, r.stderr)
+    # only mujoco's two lines for an absent warp are dropped; anything else it prints stays
+    printed = ("Failed to import warp: No module named 'warp'\n"
+               "Failed to import mujoco_warp: No module named 'warp'\n"
+               "Failed to import warp: CUDA driver too old\n")
+    assert _without_warp_absent(printed) == "Failed to import warp: CUDA driver too old\n"
+
+
 def test_video_of_a_rollout_is_written(bench, tmp_path):
     from robot.video import write_video
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from vccjax import load_scene, random_scene, run
 from vccjax.world.concepts import reference_program
-from search.packing import pack_state, packed_field, unpack_state
+from search.packing import blackboard_columns, pack_state, packed_field, unpack_blackboard, unpack_state
 from vccjax.machine.state import init_state, stack
 
 
@@ -37,7 +37,10 @@ def test_pack_round_trips_single_and_batched_states_on_device_and_host():
     assert packed.shape[0] == len(states)
     host = unpack_state(packed)  # NumPy in, NumPy out
     assert _same(jax.tree.map(np.asarray, batch), host)
-    assert np.array_equal(packed_field(packed, "held"), np.asarray(batch.held))
-    assert np.array_equal(packed_field(packed, "failed"), np.asarray(batch.failed))
+    assert np.array_equal(packed_field(packed, "hand.held"), np.asarray(batch.hand.held))
+    assert np.array_equal(packed_field(packed, "control.failed"), np.asarray(batch.control.failed))
+    # the blackboard leads a row: its leading columns unpack to the blackboard memory
+    board = unpack_blackboard(packed[:, : blackboard_columns()])
+    assert _same(board, host.blackboard)
     # a state that ran a program differs from the initial one, and packing keeps that
     assert not np.array_equal(packed[0], packed[1])

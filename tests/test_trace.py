@@ -30,7 +30,8 @@ def test_trace_records_each_instruction_and_ends_where_the_run_ends(swap_scene):
     final = frames[-1].machine.output_scene()
     assert scenes_match(final, run_reference(program, swap_scene).output_scene(), 1e-9)
     assert not scenes_match(final, swap_scene, 0.02)  # the swap moved something
-    assert frames[0].machine.objects == []  # the input frame: nothing parsed yet
+    assert not frames[0].machine.blackboard.parsed  # the input frame: nothing parsed yet
+    assert not any(frames[0].machine.blackboard.alive)
 
 
 def test_loop_iterations_appear_in_the_trace():
@@ -40,8 +41,8 @@ def test_loop_iterations_appear_in_the_trace():
     fills = [f for f in frames if f.instruction == "fill_color(blue)"]
     assert [f.iteration for f in fills] == [0, 1, 2]  # three objects, three times round
     assert frames[-1].instruction == "loop_end"
-    assert [o.color for o in frames[-1].machine.objects] == [2, 2, 2]  # all blue
-    assert [o.color for o in fills[0].machine.objects].count(2) == 1  # snapshots, not one shared machine
+    assert frames[-1].machine.blackboard.color[:3] == [2, 2, 2]  # all blue
+    assert fills[0].machine.blackboard.color[:3].count(2) == 1  # snapshots, not one shared machine
 
 
 def test_a_failing_instruction_ends_the_trace_marked():

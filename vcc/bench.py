@@ -44,7 +44,7 @@ def stamp() -> dict:
 def _search_jobs(a: argparse.Namespace):
     from search.chain import Chain
     from vccjax.world.concepts import concept_list
-    from search.explore import Task
+    from search.task import Task
     from search.induce import Settings, argument_logp
     from search.model import MarkovModel, Vocabulary
     from vccjax.world.concepts import all_concepts, concept_names

@@ -39,11 +39,12 @@ class _Enough(Exception):
 def record_stream(chains_tasks: Sequence, per_concept: int) -> list[tuple[int, Program, int, int]]:
     """Up to `per_concept` children of each concept's search: (concept index, parent
     prefix, last op, last arg), in the order the search steps them."""
-    from search.scalar import ScalarExplorer
+    from search.explore import Searcher
+    from search.scalar import ScalarBackend
 
     out: list[tuple[int, Program, int, int]] = []
 
-    class Recorder(ScalarExplorer):
+    class Recorder(ScalarBackend):
         def root_states(self, task):
             roots = super().root_states(task)
             for m in roots[0]:
@@ -51,24 +52,24 @@ def record_stream(chains_tasks: Sequence, per_concept: int) -> list[tuple[int, P
             return roots
 
         def apply(self, request):
-            kids, failed, ok = super().apply(request)
+            reply = super().apply(request)
             for i, z in enumerate(request.portions):
                 parent = request.states[request.parents[i]][0].prefix
                 ops, args = list(parent[0]), list(parent[1])
-                steps = list(zip(request.chain.ops[z], request.chain.args[z]))
+                steps = list(zip(request.chain.ops[z], request.chain.args[z], strict=True))
                 for op, arg in steps[:-1]:  # a subroutine's body but its last instruction joins the prefix
                     ops.append(op)
                     args.append(arg)
                 out.append((j, Program(tuple(ops), tuple(args)), int(steps[-1][0]), int(steps[-1][1])))
-                for m in kids[i]:
+                for m in reply.states[i]:
                     m.prefix = (tuple(ops) + (steps[-1][0],), tuple(args) + (steps[-1][1],))
                 if sum(1 for c in out if c[0] == j) >= per_concept:
                     raise _Enough
-            return kids, failed, ok
+            return reply
 
     for j, (chain, task) in enumerate(chains_tasks):  # noqa: B007 (`j` is read by Recorder.apply)
         try:
-            Recorder().search(chain, task, 10**9)
+            Searcher(Recorder()).search(chain, task, 10**9)
         except _Enough:
             pass
     return out
@@ -158,13 +159,14 @@ def step_jax(p: Prepared, prepared: dict[int, list]) -> tuple[dict[int, list], d
 
 def _step(cfg: VCCConfig, op: int, consts, tasks, states, args):
     """As the search steps: a closed loop's further iterations are replayed one body
-    instruction at a time with that instruction's code only (`Explorer._replay`), not in
+    instruction at a time with that instruction's code only (`JaxBackend._replay_loops`), not in
     a traced loop that runs every instruction's code."""
     if op != OP["loop_end"]:
         return step_examples(cfg, op, consts, tasks, states, args)
     states = step_examples(cfg, op, consts, tasks, states, args, False)
-    ops, body_args = np.asarray(states.body_ops[:, 0]), np.asarray(states.body_args[:, 0])
-    length, pc0 = np.asarray(states.body_len[:, 0]), np.asarray(states.body_pc0[:, 0])
+    control = states.control
+    ops, body_args = np.asarray(control.body_ops[:, 0]), np.asarray(control.body_args[:, 0])
+    length, pc0 = np.asarray(control.body_len[:, 0]), np.asarray(control.body_pc0[:, 0])
     iteration = 1
     while True:
         active = np.asarray(loop_needs_iteration(cfg, states, iteration))  # (B, E)
@@ -210,9 +212,9 @@ def agree(p: Prepared, jax_out: dict, ref_kids: list) -> bool:
                 r = int(g["rows"][i])
                 j = p.children[r][0]
                 for e, m in enumerate(ref_kids[r]):
-                    if bool(states.failed[k, e]) != m.failed:
+                    if bool(states.control.failed[k, e]) != m.failed:
                         return False
-                    if not m.failed and m.parsed:
+                    if not m.failed and m.blackboard.parsed:
                         c = jax.tree.map(lambda a, j=j, e=e: a[j, e], consts)
                         s = jax.tree.map(lambda a, k=k, e=e: a[k, e], states)
                         if not scenes_match(output_scene(c, s, p.cfg), m.output_scene(), 1e-9):

@@ -85,11 +85,11 @@ def cmd_run(a: argparse.Namespace) -> int:
     program, scene, note, expected = program_and_scene(a)
     if a.engine == "reference":
         m = run_reference(program, scene, cfg)
-        failed, index, reason, out = m.failed, m.fail_index, m.fail_reason, m.output_scene()
+        failed, index, reason, out = m.failed, m.control.fail_index, m.fail_reason, m.output_scene()
     else:
         c = load_scene(scene, cfg)
         st = run(program, c, cfg)
-        failed, index, reason = bool(st.failed), int(st.fail_index), None
+        failed, index, reason = bool(st.control.failed), int(st.control.fail_index), None
         out = output_scene(c, st, cfg, scene.pointer)
     print(f"program ({len(program)} instructions): {program}")
     print(f"{note}; engine: {a.engine}")

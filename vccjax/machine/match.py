@@ -18,7 +18,7 @@ from flax import struct
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.instructions import COLORS, SHAPES
 from vccjax.machine.scene import Scene
-from vccjax.machine.state import SceneConst, VCCState, centres
+from vccjax.machine.state import Blackboard, SceneConst, centres
 
 NO, YES, ASK = 0, 1, 2
 
@@ -51,17 +51,18 @@ def load_target(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG) -> Target:
 BAND = 0.25  # squared position units around tau where float32 is not trusted: ASK
 
 
-def verdict(cfg: VCCConfig, c: SceneConst, s: VCCState, t: Target) -> jax.Array:
-    """NO / YES / ASK for one state against one target (not failed is checked apart)."""
-    d = centres(c, s, cfg).astype(jnp.float32)[:, None, :] - t.pos[None, :, :]
+def verdict(cfg: VCCConfig, c: SceneConst, b: Blackboard, t: Target) -> jax.Array:
+    """NO / YES / ASK for one state's blackboard against one target (not failed is checked
+    apart; a search passes the blackboard alone, `search.packing.unpack_blackboard`)."""
+    d = centres(c, b, cfg).astype(jnp.float32)[:, None, :] - t.pos[None, :, :]
     d2 = jnp.sum(d * d, axis=-1)
     tau2 = (cfg.tau * cfg.units) ** 2
-    same = (s.alive[:, None] & t.alive[None, :] & (c.shape[:, None] == t.shape[None, :])
-            & (s.color[:, None] == t.color[None, :]))
+    same = (b.alive[:, None] & t.alive[None, :] & (c.shape[:, None] == t.shape[None, :])
+            & (b.color[:, None] == t.color[None, :]))
     ok = same & (d2 <= tau2 - BAND)
     unsure = jnp.any(same & (jnp.abs(d2 - tau2) < BAND))  # on the edge of tau: the host decides
     rows, cols = ok.sum(1), ok.sum(0)
-    same_count = s.alive.sum() == t.alive.sum()
-    missing = jnp.any(s.alive & (rows == 0)) | jnp.any(t.alive & (cols == 0))
+    same_count = b.alive.sum() == t.alive.sum()
+    missing = jnp.any(b.alive & (rows == 0)) | jnp.any(t.alive & (cols == 0))
     unique = jnp.all(rows <= 1) & jnp.all(cols <= 1)
     return jnp.where(~same_count, NO, jnp.where(unsure | ~unique, ASK, jnp.where(missing, NO, YES))).astype(jnp.int32)

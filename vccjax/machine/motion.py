@@ -58,7 +58,8 @@ def _lines(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int):
     axis 0: lines are rows, runs are columns; axis 1: lines are columns, runs are rows.
     """
     table, start = (c.runs, c.corner[:, 0]) if axis == 0 else (c.cruns, c.corner[:, 1])
-    line_off, run_off = (s.offset[:, 1], s.offset[:, 0]) if axis == 0 else (s.offset[:, 0], s.offset[:, 1])
+    off = s.blackboard.offset
+    line_off, run_off = (off[:, 1], off[:, 0]) if axis == 0 else (off[:, 0], off[:, 1])
     lines = (start + line_off)[:, None] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
     shifted = table + run_off[:, None, None]
     return lines, shifted[..., 0::2], shifted[..., 1::2]
@@ -75,7 +76,7 @@ def occupancy(
     and lines past the raster are empty): a scatter of N blocks, not of N * K lines.
     """
     lines, lo, hi = _lines(c, s, cfg, axis)
-    keep = s.alive & (jnp.arange(cfg.n_max) != exclude)
+    keep = s.blackboard.alive & (jnp.arange(cfg.n_max) != exclude)
     bits = fold(jnp.bitwise_or, run_bits(lo, hi, cfg), 2)  # (N, K, W)
     bits = jnp.where(keep[:, None, None], bits, jnp.uint32(0))
     blocks = jax.lax.ScatterDimensionNumbers(
@@ -84,7 +85,7 @@ def occupancy(
     occ = jnp.zeros((cfg.raster + cfg.mask_rows, cfg.words), jnp.uint32)
     occ = jax.lax.scatter_add(occ, lines[:, :1], bits, blocks)[: cfg.raster]
     if imagined:
-        im = imagined_runs(s.imag_kind, s.imag_pos, cfg)[axis]
+        im = imagined_runs(s.blackboard.imagined_kind, s.blackboard.imagined_position, cfg)[axis]
         occ = occ | run_bits(im[:, 0], im[:, 1], cfg)
     return occ
 
@@ -93,10 +94,11 @@ def contains(c: SceneConst, s: VCCState, cfg: VCCConfig, point: jax.Array) -> ja
     """(N,) whether each alive object's mask holds the pixel of `point` (position units)."""
     col = jnp.minimum(point[0] // cfg.sub, cfg.raster - 1)
     row = jnp.minimum(point[1] // cfg.sub, cfg.raster - 1)
-    k = row - (c.corner[:, 0] + s.offset[:, 1])
-    ok = (k >= 0) & (k < cfg.mask_rows) & s.alive
+    b = s.blackboard
+    k = row - (c.corner[:, 0] + b.offset[:, 1])
+    ok = (k >= 0) & (k < cfg.mask_rows) & b.alive
     runs = c.runs[jnp.arange(cfg.n_max), jnp.clip(k, 0, cfg.mask_rows - 1)]
-    x = col - s.offset[:, 0]
+    x = col - b.offset[:, 0]
     inside = ((x >= runs[:, 0]) & (x <= runs[:, 1])) | ((x >= runs[:, 2]) & (x <= runs[:, 3]))
     return ok & inside
 
@@ -147,7 +149,7 @@ def slide(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int, sign: int) -> V
 
     axis 0 moves along x (left/right), axis 1 along y (up/down); sign is +1 or -1.
     """
-    i = s.held
+    i = s.hand.held
     r = cfg.raster
     occ = occupancy(c, s, cfg, exclude=i, axis=0 if axis == 0 else 1)
     lines, lo, hi = _lines(c, s, cfg, 0 if axis == 0 else 1)
@@ -163,11 +165,17 @@ def slide(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int, sign: int) -> V
         last = jnp.max(jnp.where(behind != 0, start + 31 - jax.lax.clz(behind).astype(jnp.int32), -1), axis=-1)
         gap = lo - last - 1
     shift = jnp.min(jnp.where(lo <= hi, gap, r))
-    off = s.offset[i, axis]
+    off = s.blackboard.offset[i, axis]
     room = c.box[i, 2 * axis + 1] - off if sign > 0 else off - c.box[i, 2 * axis]
     shift = jnp.minimum(shift, room)  # the object's w x w box stays in the workspace
-    delta = jnp.zeros(2, jnp.int32).at[axis].set(sign * shift)
-    return s.replace(offset=s.offset.at[i].add(delta), hand=s.hand + delta * cfg.sub)
+    return _carried(s, cfg, jnp.zeros(2, jnp.int32).at[axis].set(sign * shift))
+
+
+def _carried(s: VCCState, cfg: VCCConfig, delta: jax.Array) -> VCCState:
+    """The held object and the hand moved by `delta` whole pixels."""
+    b, h = s.blackboard, s.hand
+    return s.replace(blackboard=b.replace(offset=b.offset.at[h.held].add(delta)),
+                     hand=h.replace(position=h.position + delta * cfg.sub))
 
 
 def toward_path(start: jax.Array, target: jax.Array, cfg: VCCConfig) -> jax.Array:
@@ -190,10 +198,11 @@ def carry_toward(c: SceneConst, s: VCCState, cfg: VCCConfig, target: jax.Array) 
     the K occupancy lines under it, read as one slice of the padded bitmap. The test ORs
     the words, then the lines, by `fold` (in that order): under vmap on CPU, a reduce
     there was most of the carry's time."""
-    i = s.held
+    i = s.hand.held
     k, w = cfg.mask_rows, cfg.words
-    path = toward_path(c.base[i] + s.offset[i] * cfg.sub, target, cfg)  # (P, 2)
-    total = s.offset[i][None, :] + path  # (P, 2) offsets since load
+    off = s.blackboard.offset[i]
+    path = toward_path(c.base[i] + off * cfg.sub, target, cfg)  # (P, 2)
+    total = off[None, :] + path  # (P, 2) offsets since load
     box = c.box[i]
     out = (
         (total[:, 0] < box[0]) | (total[:, 0] > box[1]) | (total[:, 1] < box[2]) | (total[:, 1] > box[3])
@@ -213,5 +222,4 @@ def carry_toward(c: SceneConst, s: VCCState, cfg: VCCConfig, target: jax.Array) 
 
     bad = out | jax.vmap(hits)(path)
     first_bad = jnp.where(bad.any(), jnp.argmax(bad), path.shape[0])
-    delta = path[jnp.maximum(first_bad - 1, 0)]
-    return s.replace(offset=s.offset.at[i].add(delta), hand=s.hand + delta * cfg.sub)
+    return _carried(s, cfg, path[jnp.maximum(first_bad - 1, 0)])

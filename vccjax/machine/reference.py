@@ -2,13 +2,13 @@
 
 It is the oracle the JAX emulator is tested against and the baseline of the
 benchmarks. Every rule of docs/vcc.md sections 2-5 appears here once, in the order of
-the instruction table of section 3.
+the instruction table of section 3. It holds the same five memories as the JAX state,
+under the same names (`memories.py`), in plain Python.
 """
 
 from __future__ import annotations
 
 import copy
-import dataclasses
 
 import numpy as np
 
@@ -22,18 +22,10 @@ from vccjax.machine.instructions import (
     REQUIRED_IN_LOOP,
     SHAPES,
 )
+from vccjax.machine.memories import MEMORIES, Attention, Blackboard, Control, Fovea, Hand, copied
 from vccjax.machine.program import Program
-from vccjax.machine.scene import Scene, SceneObject, box_inside, to_units
-
-
-@dataclasses.dataclass
-class RefObject:
-    shape: int
-    color: int
-    x: int  # centre, integer position units
-    y: int
-    width: float
-    alive: bool = True
+from vccjax.machine.reference_motion import carry, straight, toward
+from vccjax.machine.scene import Scene, SceneObject, to_units
 
 
 class Failure(Exception):
@@ -41,46 +33,41 @@ class Failure(Exception):
 
 
 class RefMachine:
-    """One VCC running on one scene."""
+    """One VCC running on one scene: the scene's constants and the five memories."""
 
     def __init__(self, scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG, validate: bool = True):
         if validate:
             scene.validate(cfg)
         self.cfg = cfg
         self.scene = scene
-        u = cfg.units
-        centre = (u // 2, u // 2)
-        self.parsed = False
-        self.objects: list[RefObject] = []
-        self.pointer: tuple[int, int] | None = None
-        self.imagined: tuple[int, int, int] | None = None  # (kind, x, y)
-        self.fovea = centre
-        self.history = [centre]
-        self.h = 0
-        self.hand = centre
-        self.held: int | None = None
-        self.shape_filter: int | None = None
-        self.color_filter: int | None = None
-        self.attended_list: list[int] = []
-        self.stale = True
-        self.k = 0
-        self.attended: int | None = None
-        self.failed = False
-        self.fail_index: int | None = None
+        # what the scene fixes, per object slot: shape, width, centre at load (position units)
+        self.shapes = [SHAPES.index(o.shape) for o in scene.objects]
+        self.widths = [float(o.width) for o in scene.objects]
+        self.bases = [(to_units(o.x, cfg), to_units(o.y, cfg)) for o in scene.objects]
+        self.pointer = None if scene.pointer is None else (to_units(scene.pointer[0], cfg),
+                                                           to_units(scene.pointer[1], cfg))
+        centre = (cfg.units // 2, cfg.units // 2)
+        n = max(cfg.n_max, len(scene.objects))  # n_max slots (an unvalidated scene may hold more)
+        self.blackboard = Blackboard(parsed=False, alive=[False] * n, color=[0] * n, offset=[(0, 0)] * n,
+                                     imagined_kind=-1, imagined_position=(0, 0))
+        self.fovea = Fovea(position=centre, history=[centre], history_index=0)
+        self.attention = Attention(shape_filter=-1, color_filter=-1, attended_list=[], stale=True,
+                                   cursor=0, attended=-1)
+        self.hand = Hand(position=centre, held=-1)
+        self.control = Control(failed=False, fail_index=-1, pc=0, in_loop=False, loop_active=False,
+                               body_ops=[], body_args=[], body_pc0=0)
         self.fail_reason: str | None = None
-        self.pc = 0
-        self.in_loop = False
-        self.loop_active = False
-        self.body: list[tuple[int, int, int]] = []  # (op, arg, program index)
         self.watch = None  # called as watch(machine, op, arg, pc) after each instruction (vccjax.views.trace)
+
+    @property
+    def failed(self) -> bool:
+        return self.control.failed
 
     def clone(self) -> RefMachine:
         """An independent copy (the scene, read-only, is shared): a search keeps one per prefix."""
         m = copy.copy(self)
-        m.objects = [dataclasses.replace(o) for o in self.objects]
-        m.history = list(self.history)
-        m.attended_list = list(self.attended_list)
-        m.body = list(self.body)
+        for name in MEMORIES:
+            setattr(m, name, copied(getattr(self, name)))
         return m
 
     # ---- running ------------------------------------------------------------------------
@@ -93,165 +80,130 @@ class RefMachine:
 
     def step(self, op: int, arg: int = 0) -> None:
         """Take the next program instruction (with the loop bookkeeping of docs/vcc.md section 5)."""
-        if self.failed:
+        ctl = self.control
+        if ctl.failed:
             return
-        pc = self.pc
-        self.pc += 1
+        pc = ctl.pc
+        ctl.pc += 1
         name = NAMES[op]
         try:
-            if self.in_loop and name != "loop_end":
+            if ctl.in_loop and name != "loop_end":
                 if name in FORBIDDEN_IN_LOOP:
                     raise Failure(f"{name} is not allowed in a loop body")
-                if len(self.body) >= self.cfg.body_max:
+                if len(ctl.body_ops) >= self.cfg.body_max:
                     raise Failure(f"loop body longer than body_max={self.cfg.body_max}")
-                self.body.append((op, arg, pc))
-                if not self.loop_active:  # zero iterations: the body is only recorded
+                ctl.body_ops.append(op)
+                ctl.body_args.append(arg)
+                if not ctl.loop_active:  # zero iterations: the body is only recorded
                     return
             self.execute(op, arg)
         except Failure as f:
-            self.failed, self.fail_index, self.fail_reason = True, pc, str(f)
-        if self.watch is not None and (not self.failed or self.fail_index == pc):
+            self.fail(pc, f)
+        if self.watch is not None and (not ctl.failed or ctl.fail_index == pc):
             self.watch(self, op, arg, pc)
+
+    def fail(self, pc: int, f: Failure) -> None:
+        self.control.failed, self.control.fail_index, self.fail_reason = True, pc, str(f)
 
     def execute(self, op: int, arg: int) -> None:
         name = NAMES[op]
-        if not self.parsed and name != "scene_parse":
+        if not self.blackboard.parsed and name != "scene_parse":
             raise Failure("no scene parsed yet")
         getattr(self, "op_" + name)(arg)
 
     # ---- helpers ------------------------------------------------------------------------
     def centre(self, i: int) -> tuple[int, int]:
-        o = self.objects[i]
-        return o.x, o.y
+        (x, y), (dx, dy), s = self.bases[i], self.blackboard.offset[i], self.cfg.sub
+        return x + dx * s, y + dy * s
+
+    def object_pixels(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        return object_pixels(SHAPES[self.shapes[i]], self.widths[i], *self.centre(i), self.cfg)
 
     def pixels(self, i: int) -> set[tuple[int, int]]:
-        o = self.objects[i]
-        rows, cols = object_pixels(o.shape, o.width, o.x, o.y, self.cfg)
+        rows, cols = self.object_pixels(i)
         return set(zip(rows.tolist(), cols.tolist()))
 
     def imagined_set(self) -> set[tuple[int, int]]:
-        if self.imagined is None:
+        b = self.blackboard
+        if b.imagined_kind < 0:
             return set()
-        rows, cols = imagined_pixels(*self.imagined, self.cfg)
+        rows, cols = imagined_pixels(b.imagined_kind, *b.imagined_position, self.cfg)
         return set(zip(rows.tolist(), cols.tolist()))
 
     def real_alive(self) -> list[int]:
-        return [i for i, o in enumerate(self.objects) if o.alive]
+        return [i for i, alive in enumerate(self.blackboard.alive) if alive]
 
     def pixel_of(self, p: tuple[int, int]) -> tuple[int, int]:
         last = self.cfg.raster - 1
         return min(p[1] // self.cfg.sub, last), min(p[0] // self.cfg.sub, last)
 
-    def object_at(self, p: tuple[int, int]) -> int | None:
+    def object_at(self, p: tuple[int, int]) -> int:
+        """The alive object whose mask holds the pixel of p, or -1."""
         pix = self.pixel_of(p)
-        for i in self.real_alive():
-            if pix in self.pixels(i):
-                return i
-        return None
+        return next((i for i in self.real_alive() if pix in self.pixels(i)), -1)
 
     def refresh(self) -> None:
-        if not self.stale:
+        a = self.attention
+        if not a.stale:
             return
-        fx, fy = self.fovea
+        fx, fy = self.fovea.position
 
         def passes(i: int) -> bool:
-            o = self.objects[i]
-            return (self.shape_filter is None or o.shape == self.shape_filter) and (
-                self.color_filter is None or o.color == self.color_filter
+            return (a.shape_filter < 0 or self.shapes[i] == a.shape_filter) and (
+                a.color_filter < 0 or self.blackboard.color[i] == a.color_filter
             )
 
-        ids = [i for i in self.real_alive() if passes(i)]
-        self.attended_list = sorted(
-            ids, key=lambda i: ((self.objects[i].x - fx) ** 2 + (self.objects[i].y - fy) ** 2, i)
-        )
-        self.stale = False
+        def key(i: int) -> tuple[int, int]:
+            x, y = self.centre(i)
+            return (x - fx) ** 2 + (y - fy) ** 2, i
+
+        a.attended_list = sorted((i for i in self.real_alive() if passes(i)), key=key)
+        a.stale = False
 
     def fixate_on(self, p: tuple[int, int]) -> None:
-        if len(self.history) >= self.cfg.hist_max:
+        f = self.fovea
+        if len(f.history) >= self.cfg.hist_max:
             raise Failure(f"fixation history full ({self.cfg.hist_max})")
-        self.history.append(p)
-        self.h = len(self.history) - 1
-        self.fovea = p
+        f.history.append(p)
+        f.history_index = len(f.history) - 1
+        f.position = p
 
     def need_held(self) -> int:
-        if self.held is None:
+        if self.hand.held < 0:
             raise Failure("not holding an object")
-        return self.held
+        return self.hand.held
 
     def need_attended(self) -> int:
-        if self.attended is None:
+        if self.attention.attended < 0:
             raise Failure("no attended object")
-        return self.attended
-
-    def carry(self, path: list[tuple[int, int]]) -> None:
-        """Move the held object along pixel offsets path[0]=(0,0), path[1], ...; stop before
-        the first offset where it would overlap another object or its w x w box would
-        leave the workspace."""
-        i = self.need_held()
-        o = self.objects[i]
-        s = self.cfg.sub
-        w = to_units(o.width, self.cfg)
-        # the other objects' and the imagined pixels on a raster with a wide margin (masks
-        # may reach past the workspace); the held object moves by whole pixels, so its
-        # mask at offset (dx, dy) is its mask now shifted by (dy, dx) rows and columns
-        m = 2 * self.cfg.raster
-        blocked = np.zeros((5 * self.cfg.raster,) * 2, bool)
-        if self.imagined is not None:
-            rows, cols = imagined_pixels(*self.imagined, self.cfg)
-            blocked[rows + m, cols + m] = True
-        for j in self.real_alive():
-            if j != i:
-                q = self.objects[j]
-                rows, cols = object_pixels(q.shape, q.width, q.x, q.y, self.cfg)
-                blocked[rows + m, cols + m] = True
-        rows, cols = object_pixels(o.shape, o.width, o.x, o.y, self.cfg)
-        steps = np.asarray(path[1:], np.int64).reshape(-1, 2)
-        hits = blocked[rows[None, :] + m + steps[:, 1:], cols[None, :] + m + steps[:, :1]].any(axis=1)
-        last = (0, 0)
-        for (dx, dy), hit in zip(steps.tolist(), hits.tolist()):
-            if hit or not box_inside(o.x + dx * s, o.y + dy * s, w, self.cfg):
-                break
-            last = (dx, dy)
-        o.x += last[0] * s
-        o.y += last[1] * s
-        self.hand = (self.hand[0] + last[0] * s, self.hand[1] + last[1] * s)
+        return self.attention.attended
 
     def carry_toward(self, target: tuple[int, int]) -> None:
         i = self.need_held()
-        s = self.cfg.sub
-        ox, oy = self.centre(i)
-        # displacement in whole pixels, rounded half up; samples rounded half up along it
-        dpx = (2 * (target[0] - ox) + s) // (2 * s)
-        dpy = (2 * (target[1] - oy) + s) // (2 * s)
-        n = max(abs(dpx), abs(dpy))
-        path = [(0, 0)] + [
-            ((2 * t * dpx + n) // (2 * n), (2 * t * dpy + n) // (2 * n)) for t in range(1, n + 1)
-        ]
-        self.carry(path)
+        carry(self, i, toward(self.centre(i), target, self.cfg))
 
     def carry_direction(self, ux: int, uy: int) -> None:
-        self.need_held()
-        self.carry([(t * ux, t * uy) for t in range(self.cfg.raster + 1)])
+        carry(self, self.need_held(), straight(ux, uy, self.cfg))
 
     # ---- instructions (docs/vcc.md section 3) ----------------------------------------------
     def op_scene_parse(self, arg: int) -> None:
-        if self.parsed:
+        b = self.blackboard
+        if b.parsed:
             raise Failure("scene_parse is not first")
-        self.parsed = True
-        self.objects = [
-            RefObject(SHAPES.index(o.shape), COLORS.index(o.color),
-                      to_units(o.x, self.cfg), to_units(o.y, self.cfg), float(o.width))
-            for o in self.scene.objects
-        ]
-        if self.scene.pointer is not None:
-            self.pointer = (to_units(self.scene.pointer[0], self.cfg),
-                            to_units(self.scene.pointer[1], self.cfg))
+        b.parsed = True
+        n = len(self.scene.objects)
+        b.alive = [i < n for i in range(len(b.alive))]
+        b.color = [COLORS.index(o.color) for o in self.scene.objects] + [0] * (len(b.alive) - n)
+        b.offset = [(0, 0)] * len(b.alive)
 
     def _set_filter(self, which: str, arg: int) -> None:
-        if getattr(self, which) is not None:
+        if getattr(self.attention, which) >= 0:
             raise Failure(f"{which.replace('_', ' ')} already set")
-        setattr(self, which, arg)
-        self.stale, self.k, self.attended = True, 0, None
+        setattr(self.attention, which, arg)
+        self._unattend()
+
+    def _unattend(self) -> None:
+        self.attention.stale, self.attention.cursor, self.attention.attended = True, 0, -1
 
     def op_set_shape_attn(self, arg: int) -> None:
         self._set_filter("shape_filter", arg)
@@ -260,29 +212,31 @@ class RefMachine:
         self._set_filter("color_filter", arg)
 
     def op_reset_attn(self, arg: int) -> None:
-        self.shape_filter = self.color_filter = None
-        self.stale, self.k, self.attended = True, 0, None
+        self.attention.shape_filter = self.attention.color_filter = -1
+        self._unattend()
 
     def op_top_down_attend(self, arg: int) -> None:
         self.refresh()
-        if self.k >= len(self.attended_list):
-            raise Failure(f"cursor {self.k} past the {len(self.attended_list)} attended objects")
-        self.attended = self.attended_list[self.k]
+        a = self.attention
+        if a.cursor >= len(a.attended_list):
+            raise Failure(f"cursor {a.cursor} past the {len(a.attended_list)} attended objects")
+        a.attended = a.attended_list[a.cursor]
 
     def op_next_object(self, arg: int) -> None:
         self.refresh()
-        self.k += 1
-        self.attended = None
-        if self.k > len(self.attended_list):
-            raise Failure(f"cursor {self.k} beyond the {len(self.attended_list)} attended objects")
+        a = self.attention
+        a.cursor += 1
+        a.attended = -1
+        if a.cursor > len(a.attended_list):
+            raise Failure(f"cursor {a.cursor} beyond the {len(a.attended_list)} attended objects")
 
     def op_attend_pointer(self, arg: int) -> None:
         if self.pointer is None:
             raise Failure("no pointer")
         i = self.object_at(self.pointer)
-        if i is None:
+        if i < 0:
             raise Failure("no object under the pointer")
-        self.attended = i
+        self.attention.attended = i
 
     def op_fixate(self, arg: int) -> None:
         u = self.cfg.units
@@ -301,37 +255,39 @@ class RefMachine:
         self.fixate_on(self.pointer)
 
     def op_fixate_previous(self, arg: int) -> None:
-        if self.h == 0:
+        f = self.fovea
+        if f.history_index == 0:
             raise Failure("no previous fixation")
-        self.h -= 1
-        self.fovea = self.history[self.h]
+        f.history_index -= 1
+        f.position = f.history[f.history_index]
 
     def op_fixate_next(self, arg: int) -> None:
-        if self.h == len(self.history) - 1:
+        f = self.fovea
+        if f.history_index == len(f.history) - 1:
             raise Failure("no next fixation")
-        self.h += 1
-        self.fovea = self.history[self.h]
+        f.history_index += 1
+        f.position = f.history[f.history_index]
 
     def op_move_hand_to_attended_object(self, arg: int) -> None:
         a = self.need_attended()
-        if self.held is None:
-            self.hand = self.centre(a)
-        elif a == self.held:
+        if self.hand.held < 0:
+            self.hand.position = self.centre(a)
+        elif a == self.hand.held:
             raise Failure("the attended object is the held object")
         else:
             self.carry_toward(self.centre(a))
 
     def op_grab_object(self, arg: int) -> None:
-        if self.held is not None:
+        if self.hand.held >= 0:
             raise Failure("already holding an object")
-        i = self.object_at(self.hand)
-        if i is None:
+        i = self.object_at(self.hand.position)
+        if i < 0:
             raise Failure("no object at the hand")
-        self.held = i
+        self.hand.held = i
 
     def op_release_object(self, arg: int) -> None:
         self.need_held()
-        self.held = None
+        self.hand.held = -1
 
     def op_move_hand_left(self, arg: int) -> None:
         self.carry_direction(-1, 0)
@@ -353,58 +309,61 @@ class RefMachine:
 
     def op_move_hand_to_fixate_collision(self, arg: int) -> None:
         self.need_held()
-        self.carry_toward(self.fovea)
+        self.carry_toward(self.fovea.position)
 
     def op_fill_color(self, arg: int) -> None:
-        self.objects[self.need_attended()].color = arg
+        self.blackboard.color[self.need_attended()] = arg
 
     def op_remove_from_imagine_buffer(self, arg: int) -> None:
         a = self.need_attended()
-        self.objects[a].alive = False
-        if self.held == a:
-            self.held = None
-        self.attended, self.stale = None, True
+        self.blackboard.alive[a] = False
+        if self.hand.held == a:
+            self.hand.held = -1
+        self.attention.attended, self.attention.stale = -1, True
 
     def op_imagine_object(self, arg: int) -> None:
-        if self.imagined is not None:
+        b, (fx, fy) = self.blackboard, self.fovea.position
+        if b.imagined_kind >= 0:
             raise Failure("an imagined object exists")
-        footprint = imagined_pixels(arg, self.fovea[0], self.fovea[1], self.cfg)
+        footprint = imagined_pixels(arg, fx, fy, self.cfg)
         footprint = set(zip(footprint[0].tolist(), footprint[1].tolist()))
         for i in self.real_alive():
             if footprint & self.pixels(i):
                 raise Failure("the imagined object would overlap an object")
-        self.imagined = (arg, self.fovea[0], self.fovea[1])
+        b.imagined_kind, b.imagined_position = arg, (fx, fy)
 
     def op_reset_imagination(self, arg: int) -> None:
-        if self.imagined is None:
+        if self.blackboard.imagined_kind < 0:
             raise Failure("no imagined object")
-        self.imagined = None
+        self.blackboard.imagined_kind = -1
 
     def op_loop_start(self, arg: int) -> None:
         self.refresh()
-        self.in_loop = True
-        self.loop_active = self.k < len(self.attended_list)
-        self.body = []
+        ctl, a = self.control, self.attention
+        ctl.in_loop = True
+        ctl.loop_active = a.cursor < len(a.attended_list)
+        ctl.body_ops, ctl.body_args, ctl.body_pc0 = [], [], ctl.pc
 
     def op_loop_end(self, arg: int) -> None:
-        if not self.in_loop:
+        ctl, a = self.control, self.attention
+        if not ctl.in_loop:
             raise Failure("loop_end without loop_start")
-        names = {NAMES[op] for op, _, _ in self.body}
-        if not REQUIRED_IN_LOOP <= names:
+        if not REQUIRED_IN_LOOP <= {NAMES[op] for op in ctl.body_ops}:
             raise Failure("loop body lacks top_down_attend or next_object")
-        self.in_loop = False
-        if not self.loop_active:
+        ctl.in_loop = False
+        if not ctl.loop_active:
             return
         iterations = 1  # the first ran eagerly
-        while iterations < self.cfg.n_max and self.k < len(self.attended_list):
-            for op, arg, pc in self.body:
+        while iterations < self.cfg.n_max and a.cursor < len(a.attended_list):
+            for j, (op, arg) in enumerate(zip(ctl.body_ops, ctl.body_args)):
+                pc = ctl.body_pc0 + j
                 try:
                     self.execute(op, arg)
                 except Failure as f:
-                    self.failed, self.fail_index, self.fail_reason = True, pc, str(f)
+                    self.fail(pc, f)
                 if self.watch is not None:
                     self.watch(self, op, arg, pc)
-                if self.failed:
+                if ctl.failed:
                     return
             iterations += 1
 
@@ -412,8 +371,8 @@ class RefMachine:
     def output_scene(self) -> Scene:
         u = self.cfg.units
         objs = tuple(
-            SceneObject(SHAPES[o.shape], COLORS[o.color], o.x / u, o.y / u, o.width)
-            for o in self.objects if o.alive
+            SceneObject(SHAPES[self.shapes[i]], COLORS[self.blackboard.color[i]], x / u, y / u, self.widths[i])
+            for i in self.real_alive() for x, y in [self.centre(i)]
         )
         return Scene(objs, self.scene.pointer)
 

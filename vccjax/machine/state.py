@@ -2,14 +2,12 @@
 
 `SceneConst` holds what a scene fixes (shapes, widths, masks at load time, the
 pointer) and is shared by every program prefix run on that scene; `VCCState` holds
-what instructions change. Object masks are not stored: an object's mask is its
-load-time mask (two column runs per row) shifted by its whole-pixel offset.
+what instructions change, as the five memories of `memories.py` (the reference's have
+the same names). Object masks are not stored: an object's mask is its load-time mask
+(two column runs per row) shifted by its whole-pixel offset.
 """
 
 from __future__ import annotations
-
-import dataclasses
-import functools
 
 import jax
 import jax.numpy as jnp
@@ -19,6 +17,7 @@ from flax import struct
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.geometry import mask_intervals, object_pixels
 from vccjax.machine.instructions import COLORS, SHAPES
+from vccjax.machine.memories import padded
 from vccjax.machine.scene import Scene, SceneObject, to_units
 
 
@@ -38,35 +37,63 @@ class SceneConst:
 
 
 @struct.dataclass
-class VCCState:
+class Blackboard:
     parsed: jax.Array  # () bool
     alive: jax.Array  # (N,) bool
     color: jax.Array  # (N,)
     offset: jax.Array  # (N, 2) whole-pixel displacement since load (x, y)
-    imag_kind: jax.Array  # () -1 none, 0 circle, 1 hline
-    imag_pos: jax.Array  # (2,)
-    fovea: jax.Array  # (2,)
-    hist: jax.Array  # (H, 2) fixation history
-    hist_len: jax.Array  # ()
-    hist_idx: jax.Array  # () h
-    hand: jax.Array  # (2,)
-    held: jax.Array  # () slot or -1
+    imagined_kind: jax.Array  # () -1 none, 0 circle, 1 hline
+    imagined_position: jax.Array  # (2,)
+
+
+@struct.dataclass
+class Fovea:
+    position: jax.Array  # (2,)
+    history: jax.Array = padded("history_len")  # (H, 2) fixations
+    history_len: jax.Array  # ()
+    history_index: jax.Array  # () h
+
+
+@struct.dataclass
+class Attention:
     shape_filter: jax.Array  # () -1 unset
     color_filter: jax.Array  # () -1 unset
-    attn: jax.Array  # (N,) attended list A (slots, -1 padded)
-    attn_len: jax.Array  # ()
+    attended_list: jax.Array = padded("attended_list_len")  # (N,) A, slots (-1 padded)
+    attended_list_len: jax.Array  # ()
     stale: jax.Array  # () bool
     cursor: jax.Array  # () k
     attended: jax.Array  # () slot or -1
+
+
+@struct.dataclass
+class Hand:
+    position: jax.Array  # (2,)
+    held: jax.Array  # () slot or -1
+
+
+@struct.dataclass
+class Control:
     failed: jax.Array  # () bool
     fail_index: jax.Array  # () program index of the failing instruction, -1 if none
     pc: jax.Array  # () index of the next program instruction
     in_loop: jax.Array  # () bool
     loop_active: jax.Array  # () bool: the loop runs at least one iteration
-    body_ops: jax.Array  # (B,)
-    body_args: jax.Array  # (B,)
+    body_ops: jax.Array = padded("body_len")  # (B,)
+    body_args: jax.Array = padded("body_len")  # (B,)
     body_len: jax.Array  # ()
     body_pc0: jax.Array  # () program index of the body's first instruction
+
+
+@struct.dataclass
+class VCCState:
+    """What instructions change, as the five memories of `memories.py` (same names as the
+    reference's); the blackboard first, so that a packed row begins with it."""
+
+    blackboard: Blackboard
+    fovea: Fovea
+    attention: Attention
+    hand: Hand
+    control: Control
 
 
 def load_scene(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG, validate: bool = True) -> SceneConst:
@@ -116,18 +143,22 @@ def init_state(cfg: VCCConfig = DEFAULT_CONFIG) -> VCCState:
     """The machine before `scene_parse`: empty blackboard, fovea and hand at the centre."""
     n, c = cfg.n_max, cfg.units // 2
     centre = jnp.array([c, c], jnp.int32)
-    i32 = jnp.int32
+    i32, no = jnp.int32, jnp.bool_(False)
     return VCCState(
-        parsed=jnp.bool_(False), alive=jnp.zeros(n, bool), color=jnp.zeros(n, i32),
-        offset=jnp.zeros((n, 2), i32), imag_kind=i32(-1), imag_pos=jnp.zeros(2, i32),
-        fovea=centre,
-        hist=jnp.zeros((cfg.hist_max, 2), i32).at[0].set(centre), hist_len=i32(1),
-        hist_idx=i32(0), hand=centre, held=i32(-1), shape_filter=i32(-1), color_filter=i32(-1),
-        attn=jnp.full(n, -1, i32), attn_len=i32(0), stale=jnp.bool_(True), cursor=i32(0),
-        attended=i32(-1), failed=jnp.bool_(False), fail_index=i32(-1), pc=i32(0),
-        in_loop=jnp.bool_(False), loop_active=jnp.bool_(False),
-        body_ops=jnp.full(cfg.body_max, -1, i32), body_args=jnp.zeros(cfg.body_max, i32),
-        body_len=i32(0), body_pc0=i32(0),
+        blackboard=Blackboard(
+            parsed=no, alive=jnp.zeros(n, bool), color=jnp.zeros(n, i32), offset=jnp.zeros((n, 2), i32),
+            imagined_kind=i32(-1), imagined_position=jnp.zeros(2, i32)),
+        fovea=Fovea(
+            position=centre, history=jnp.zeros((cfg.hist_max, 2), i32).at[0].set(centre),
+            history_len=i32(1), history_index=i32(0)),
+        attention=Attention(
+            shape_filter=i32(-1), color_filter=i32(-1), attended_list=jnp.full(n, -1, i32),
+            attended_list_len=i32(0), stale=jnp.bool_(True), cursor=i32(0), attended=i32(-1)),
+        hand=Hand(position=centre, held=i32(-1)),
+        control=Control(
+            failed=no, fail_index=i32(-1), pc=i32(0), in_loop=no, loop_active=no,
+            body_ops=jnp.full(cfg.body_max, -1, i32), body_args=jnp.zeros(cfg.body_max, i32),
+            body_len=i32(0), body_pc0=i32(0)),
     )
 
 
@@ -136,15 +167,16 @@ def stack(trees):
     return jax.tree.map(lambda *xs: jnp.stack(xs), *trees)
 
 
-def centres(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
+def centres(c: SceneConst, b: Blackboard, cfg: VCCConfig) -> jax.Array:
     """(N, 2) current object centres in position units."""
-    return c.base + s.offset * cfg.sub
+    return c.base + b.offset * cfg.sub
 
 
 def output_scene(c: SceneConst, s: VCCState, cfg: VCCConfig, pointer=None) -> Scene:
     """The blackboard's real, alive objects as a Scene (host side, one unbatched state)."""
-    cen = np.asarray(centres(c, s, cfg))
-    alive, shape, color, width = (np.asarray(a) for a in (s.alive, c.shape, s.color, c.width))
+    b = s.blackboard
+    cen = np.asarray(centres(c, b, cfg))
+    alive, shape, color, width = (np.asarray(a) for a in (b.alive, c.shape, b.color, c.width))
     objs = tuple(
         SceneObject(SHAPES[shape[i]], COLORS[color[i]], float(cen[i, 0]) / cfg.units,
                     float(cen[i, 1]) / cfg.units, float(width[i]))
@@ -155,11 +187,11 @@ def output_scene(c: SceneConst, s: VCCState, cfg: VCCConfig, pointer=None) -> Sc
 
 def object_masks(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
     """(N, R, R) bool masks of the objects on the full raster (dead slots empty)."""
-    r = jnp.arange(cfg.raster)
-    k = r[None, :] - (c.corner[:, 0] + s.offset[:, 1])[:, None]  # (N, R) mask row per raster row
-    valid = (k >= 0) & (k < cfg.mask_rows) & s.alive[:, None]
+    r, b = jnp.arange(cfg.raster), s.blackboard
+    k = r[None, :] - (c.corner[:, 0] + b.offset[:, 1])[:, None]  # (N, R) mask row per raster row
+    valid = (k >= 0) & (k < cfg.mask_rows) & b.alive[:, None]
     runs = jnp.take_along_axis(c.runs, jnp.clip(k, 0, cfg.mask_rows - 1)[:, :, None], axis=1)
-    runs = runs + s.offset[:, None, None, 0]
+    runs = runs + b.offset[:, None, None, 0]
     col = r[None, None, :]
     inside = ((col >= runs[..., 0:1]) & (col <= runs[..., 1:2])) | (
         (col >= runs[..., 2:3]) & (col <= runs[..., 3:4])
@@ -169,4 +201,4 @@ def object_masks(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
 
 def grid15(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
     """(N, 2) cells of the 15x15 grid (cell = floor(position * 14)) of the object centres."""
-    return (centres(c, s, cfg) * 14) // cfg.units
+    return (centres(c, s.blackboard, cfg) * 14) // cfg.units

@@ -29,7 +29,8 @@ _FORBIDDEN = np.array([OP[n] for n in sorted(FORBIDDEN_IN_LOOP)], np.int32)
 # ---- committing, dispatch, loop bookkeeping -------------------------------------------
 def _commit(old: VCCState, new: VCCState, fail, pc) -> VCCState:
     out = select(fail, old, new)
-    return out.replace(failed=out.failed | fail, fail_index=jnp.where(fail, pc, out.fail_index))
+    ctl = out.control
+    return out.replace(control=ctl.replace(failed=ctl.failed | fail, fail_index=jnp.where(fail, pc, ctl.fail_index)))
 
 
 def execute(cfg: VCCConfig, c: SceneConst, s: VCCState, op: int, arg, pc, fn=None) -> VCCState:
@@ -37,7 +38,7 @@ def execute(cfg: VCCConfig, c: SceneConst, s: VCCState, op: int, arg, pc, fn=Non
     in for the op's function (a cheaper variant valid for the batch at hand)."""
     new, fail = (fn or OPS[op])(cfg, c, s, jnp.asarray(arg, jnp.int32))
     if op != OP["scene_parse"]:
-        fail = fail | ~s.parsed
+        fail = fail | ~s.blackboard.parsed
     return _commit(s, new, fail, pc)
 
 
@@ -70,16 +71,18 @@ def _replay(cfg: VCCConfig, c: SceneConst, s: VCCState, active) -> VCCState:
 
     def done(carry):
         st, it, j = carry
-        return st.failed | ((j == 0) & ((it >= cfg.n_max) | (st.cursor >= st.attn_len)))
+        a = st.attention
+        return st.control.failed | ((j == 0) & ((it >= cfg.n_max) | (a.cursor >= a.attended_list_len)))
 
     def body(carry):
         st, it, j = carry
-        st = _execute_switch(cfg, c, st, st.body_ops[j], st.body_args[j], st.body_pc0 + j, _BODY_BRANCHES)
+        ctl = st.control
+        st = _execute_switch(cfg, c, st, ctl.body_ops[j], ctl.body_args[j], ctl.body_pc0 + j, _BODY_BRANCHES)
         j = j + 1
-        wrap = j >= st.body_len
+        wrap = j >= ctl.body_len
         return st, it + wrap, jnp.where(wrap, 0, j)
 
-    start = jnp.where(active & s.loop_active & ~s.failed, 1, cfg.n_max)
+    start = jnp.where(active & s.control.loop_active & ~s.control.failed, 1, cfg.n_max)
     s, _, _ = jax.lax.while_loop(lambda cr: ~done(cr), body, (s, jnp.int32(start), jnp.int32(0)))
     return s
 
@@ -90,23 +93,24 @@ def _step(cfg: VCCConfig, c: SceneConst, s: VCCState, op, arg, run_op, replay: b
     replays them one static instruction at a time)."""
     may_end_loop = (not isinstance(op, int) or op == OP["loop_end"]) and replay
     op = jnp.asarray(op, jnp.int32)
-    pc = s.pc
-    recording = s.in_loop & (op != OP["loop_end"])
-    bad = recording & (jnp.any(op == _FORBIDDEN) | (s.body_len >= cfg.body_max))
-    slot = jnp.minimum(s.body_len, cfg.body_max - 1)
-    s1 = s.replace(
+    ctl = s.control
+    pc = ctl.pc
+    recording = ctl.in_loop & (op != OP["loop_end"])
+    bad = recording & (jnp.any(op == _FORBIDDEN) | (ctl.body_len >= cfg.body_max))
+    slot = jnp.minimum(ctl.body_len, cfg.body_max - 1)
+    s1 = s.replace(control=ctl.replace(
         pc=pc + 1,
-        body_ops=jnp.where(recording, s.body_ops.at[slot].set(op), s.body_ops),
-        body_args=jnp.where(recording, s.body_args.at[slot].set(arg), s.body_args),
-        body_len=s.body_len + recording,
-    )
+        body_ops=jnp.where(recording, ctl.body_ops.at[slot].set(op), ctl.body_ops),
+        body_args=jnp.where(recording, ctl.body_args.at[slot].set(arg), ctl.body_args),
+        body_len=ctl.body_len + recording,
+    ))
     ran = run_op(c, s1, arg, pc)
     if may_end_loop:
         ran = _replay(cfg, c, ran, (op == OP["loop_end"]) & ~recording)
-    skipped = recording & ~s.loop_active  # a zero-iteration loop only records its body
+    skipped = recording & ~ctl.loop_active  # a zero-iteration loop only records its body
     out = select(skipped, s1, ran)
     out = select(bad, _commit(s1, s1, True, pc), out)
-    return select(s.failed | (op < 0), s, out)
+    return select(ctl.failed | (op < 0), s, out)
 
 
 def step(cfg: VCCConfig, c: SceneConst, s: VCCState, op, arg) -> VCCState:

@@ -27,7 +27,7 @@ class Frame:
 
     @property
     def failed(self) -> bool:
-        return self.machine.failed and self.machine.fail_index == self.pc
+        return self.machine.failed and self.machine.control.fail_index == self.pc
 
 
 def instruction_text(op: int, arg: int) -> str:

@@ -33,7 +33,7 @@ FOVEA, HAND, ATTEND, IMAGINED = (40, 90, 230), (245, 140, 20), (220, 0, 200), (1
 
 def _blackboard(m: RefMachine, input_frame: bool) -> Scene:
     """What the machine holds (before scene_parse, or for the input panel: the scene)."""
-    return m.scene if input_frame or not m.parsed else m.output_scene()
+    return m.scene if input_frame or not m.blackboard.parsed else m.output_scene()
 
 
 def _px(v: float, units: int, size: int) -> int:
@@ -52,18 +52,18 @@ def _fit(text: str, width: int, scale: float = 0.42) -> str:
 
 
 def _box(img: np.ndarray, m: RefMachine, i: int, color, size: int, pad: int, thickness: int) -> None:
-    o, u = m.objects[i], m.cfg.units
-    h = o.width / 2 * size
-    x, y = _px(o.x, u, size), _px(o.y, u, size)
+    u, (ox, oy) = m.cfg.units, m.centre(i)
+    h = m.widths[i] / 2 * size
+    x, y = _px(ox, u, size), _px(oy, u, size)
     cv2.rectangle(img, (int(x - h) - pad, int(y - h) - pad), (int(x + h) + pad, int(y + h) + pad), color, thickness,
                   cv2.LINE_AA)
 
 
 def _scene_view(m: RefMachine, size: int, input_frame: bool) -> np.ndarray:
     img = render(_blackboard(m, input_frame), size=max(64, size)).copy()
-    u = m.cfg.units
-    if m.imagined is not None and not input_frame:  # hatched violet footprint
-        rows, cols = imagined_pixels(*m.imagined, m.cfg)
+    u, b, a = m.cfg.units, m.blackboard, m.attention
+    if b.imagined_kind >= 0 and not input_frame:  # hatched violet footprint
+        rows, cols = imagined_pixels(b.imagined_kind, *b.imagined_position, m.cfg)
         mask = np.zeros((m.cfg.raster, m.cfg.raster), np.uint8)
         mask[rows, cols] = 1
         mask = cv2.resize(mask, (size, size), interpolation=cv2.INTER_NEAREST).astype(bool)
@@ -71,28 +71,27 @@ def _scene_view(m: RefMachine, size: int, input_frame: bool) -> np.ndarray:
         hatch = ((xx + yy) // 3) % 3 == 0
         img[mask] = (0.6 * img[mask] + 0.4 * np.array(IMAGINED)).astype(np.uint8)
         img[mask & hatch] = IMAGINED
-    if input_frame or not m.parsed:
+    if input_frame or not b.parsed:
         return img
-    pts = [(_px(x, u, size), _px(y, u, size)) for x, y in m.history]
+    pts = [(_px(x, u, size), _px(y, u, size)) for x, y in m.fovea.history]
     if len(pts) > 1:
         cv2.polylines(img, [np.array(pts, np.int32)], False, GREY, 1, cv2.LINE_AA)
     for k, p in enumerate(pts[1:], 1):
         cv2.circle(img, p, 2, GREY, -1, cv2.LINE_AA)
         _text(img, str(k), (p[0] + 3, p[1] - 3), GREY, 0.3)
-    f = (_px(m.fovea[0], u, size), _px(m.fovea[1], u, size))
+    f = (_px(m.fovea.position[0], u, size), _px(m.fovea.position[1], u, size))
     cv2.circle(img, f, 9, FOVEA, 2, cv2.LINE_AA)
     cv2.line(img, (f[0] - 13, f[1]), (f[0] + 13, f[1]), FOVEA, 1, cv2.LINE_AA)
     cv2.line(img, (f[0], f[1] - 13), (f[0], f[1] + 13), FOVEA, 1, cv2.LINE_AA)
-    for rank, i in enumerate(m.attended_list if not m.stale else []):
-        if m.objects[i].alive:
-            o = m.objects[i]
-            h = o.width / 2 * size
-            _text(img, str(rank + 1), (int(_px(o.x, u, size) + h) + 2, int(_px(o.y, u, size) - h) + 4), ATTEND, 0.38)
-    if m.attended is not None and m.objects[m.attended].alive:
-        _box(img, m, m.attended, ATTEND, size, 3, 1)
-    if m.held is not None:
-        _box(img, m, m.held, HAND, size, 6, 2)
-    hx, hy = _px(m.hand[0], u, size), _px(m.hand[1], u, size)  # a two-pronged fork, opening down
+    for rank, i in enumerate(a.attended_list if not a.stale else []):
+        if b.alive[i]:
+            (x, y), h = m.centre(i), m.widths[i] / 2 * size
+            _text(img, str(rank + 1), (int(_px(x, u, size) + h) + 2, int(_px(y, u, size) - h) + 4), ATTEND, 0.38)
+    if a.attended >= 0 and b.alive[a.attended]:
+        _box(img, m, a.attended, ATTEND, size, 3, 1)
+    if m.hand.held >= 0:
+        _box(img, m, m.hand.held, HAND, size, 6, 2)
+    hx, hy = _px(m.hand.position[0], u, size), _px(m.hand.position[1], u, size)  # a two-pronged fork, opening down
     cv2.line(img, (hx - 7, hy - 12), (hx + 7, hy - 12), HAND, 2, cv2.LINE_AA)
     cv2.line(img, (hx - 7, hy - 12), (hx - 7, hy - 2), HAND, 2, cv2.LINE_AA)
     cv2.line(img, (hx + 7, hy - 12), (hx + 7, hy - 2), HAND, 2, cv2.LINE_AA)
@@ -117,15 +116,16 @@ def panel(frame: Frame, size: int = 256) -> np.ndarray:
     if frame.failed:
         _text(img, _fit(f"FAILED: {m.fail_reason}", width), (4, y), RED)
         _text(img, "the machine stops here", (4, y + 17), RED, 0.38)
-    elif not input_frame and m.parsed:
-        shape = "*" if m.shape_filter is None else SHAPES[m.shape_filter]
-        color = "*" if m.color_filter is None else COLORS[m.color_filter]
-        listed = "list stale" if m.stale else f"{len(m.attended_list)} listed, at {m.k + 1}"
+    elif not input_frame and m.blackboard.parsed:
+        a, b, i = m.attention, m.blackboard, m.hand.held
+        shape = "*" if a.shape_filter < 0 else SHAPES[a.shape_filter]
+        color = "*" if a.color_filter < 0 else COLORS[a.color_filter]
+        listed = "list stale" if a.stale else f"{len(a.attended_list)} listed, at {a.cursor + 1}"
         _text(img, _fit(f"attend {shape}/{color}: {listed}", width), (4, y), ATTEND, 0.38)
-        o = None if m.held is None else m.objects[m.held]
-        held = "hand empty" if o is None else f"holds {COLORS[o.color]} {SHAPES[o.shape]}"
-        imagined = "" if m.imagined is None else ", imagining a " + ("circle" if m.imagined[0] == 0 else "line")
-        n = len(m.history) - 1
+        held = "hand empty" if i < 0 else f"holds {COLORS[b.color[i]]} {SHAPES[m.shapes[i]]}"
+        kind = b.imagined_kind
+        imagined = "" if kind < 0 else ", imagining a " + ("circle" if kind == 0 else "line")
+        n = len(m.fovea.history) - 1
         fixations = f"{n} fixation" + ("" if n == 1 else "s")
         _text(img, _fit(f"{held}, {fixations}{imagined}", width), (4, y + 17), INK, 0.38)
     if frame.failed:

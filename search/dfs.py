@@ -1,0 +1,155 @@
+"""The enumeration: every program under a description-length cutoff, depth first.
+
+Depth-first over chunks of the frontier (memory stays bounded by depth x chunk): a
+frame holds up to `chunk` live prefixes with their states on all examples; its
+children (prefix + one portion) are made cheapest first and handed to the backend in
+slices. A child that fails on any example is dropped with its whole subtree (docs/vcc.md
+section 3); so is one whose cheapest completion costs more than the cutoff. A child
+that may end is a complete program: the backend judges it against every example's
+output. The search runs to the end of the tree (paper: DFS to completion) but, once a
+program is found, only cheaper ones can replace it, so the cutoff drops to just below
+its cost.
+
+Budget: the M most probable programs, exactly. The cutoff b* is the first cost (in
+bins) at which at least M programs exist; all programs cheaper than b* are checked,
+and programs costing exactly b* until M have been checked.
+
+The search is a coroutine (`depth_first`): it yields a `Request` and receives the
+backend's `Reply`, so one caller can interleave many concepts' searches and answer
+their requests together (`search.lockstep`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Generator
+from typing import NamedTuple
+
+import numpy as np
+
+from search.backend import Backend, Reply, Request
+from search.chain import NOT_STARTED, OUTSIDE, Chain, cutoff_for_budget
+from search.result import Outcome
+from search.task import Task
+
+MAX_PORTIONS = 40  # deepest path searched (portions)
+
+
+class _Children(NamedTuple):
+    """A frame's children under the cutoff when the frame was first visited, cheapest first."""
+
+    parent: np.ndarray  # row of the parent prefix in the frame
+    portion: np.ndarray  # the portion the child adds
+    cost: np.ndarray  # bins so far (the end not counted)
+    bound: np.ndarray  # bins of the cheapest complete program through the child
+
+
+@dataclasses.dataclass
+class _Frame:
+    """Up to `chunk` live prefixes of one depth, and how far their children have been run."""
+
+    states: object  # as the backend holds them, one entry per prefix
+    last_token: np.ndarray  # (n,) last token (the end marker at the root)
+    syntax: np.ndarray  # (n,) syntax automaton state
+    cost: np.ndarray  # (n,) bins so far (the end not counted)
+    path: np.ndarray  # (n, MAX_PORTIONS) portions so far, -1 padded
+    depth: int
+    children: _Children | None = None  # made when the frame is first visited
+    next_child: int = 0  # children before this one have been run
+
+
+class _Budget:
+    """The cutoff and the programs counted against the budget, as the search lowers it."""
+
+    def __init__(self, chain: Chain, budget: int):
+        self.b_star, self.counts = cutoff_for_budget(chain, budget)
+        cheaper = int(self.counts[self.b_star - 1]) if self.b_star > 0 else 0
+        self.quota = budget - cheaper  # programs of cost exactly b* still allowed
+        self.cutoff = self.b_star  # the most a program may cost (bins)
+        self.programs = 0  # complete programs counted
+        self.best: tuple[int, np.ndarray] | None = None
+
+    def counts_program(self, cost: int) -> bool:
+        """Count a complete program that ran on every example; False if it lies beyond the
+        budget (a program at b* once M programs have been counted)."""
+        if cost == self.b_star:
+            if self.quota <= 0:
+                return False
+            self.quota -= 1
+            if self.quota == 0:
+                self.cutoff = min(self.cutoff, self.b_star - 1)
+        self.programs += 1
+        return True
+
+    def found(self, cost: int, path: np.ndarray) -> None:
+        """A program that explains every example: keep it if it is the cheapest so far."""
+        if self.best is None or cost < self.best[0]:
+            self.best = (cost, path.copy())
+            self.cutoff = min(self.cutoff, cost - 1)
+
+
+def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chunk: int, slice_size: int,
+                progress: Callable[[int], None] | None = None) -> Generator[Request, Reply, Outcome]:
+    """The search of one concept as a coroutine: yields a `Request` for each slice of up
+    to `slice_size` children, receives the backend's `Reply`; returns the `Outcome`.
+    `backend` is used for root states and `take` only (the caller applies the requests)."""
+    limits = _Budget(chain, budget)
+    frames = [_Frame(backend.root_states(task), np.array([chain.end]), np.array([NOT_STARTED]), np.array([0]),
+                     np.full((1, MAX_PORTIONS), -1, np.int32), 0)]
+    nodes = 0
+    end_bins = chain.trans_bins[:, chain.end]  # the cost of ending after each token
+    while frames:
+        frame = frames[-1]
+        if frame.children is None:
+            frame.children = _children(chain, frame, limits.cutoff)
+        picked = _next_slice(frame, limits.cutoff, slice_size)
+        if picked is None:
+            frames.pop()
+            continue
+        parents, portions, cost = (a[picked] for a in frame.children[:3])
+        tokens = chain.tok[portions]
+        syntax = chain.next_syn[tokens, frame.syntax[parents]]
+        cost_ended = cost + end_bins[tokens]
+        may_end = (syntax == OUTSIDE) & (cost_ended <= limits.cutoff)
+        reply = yield Request(chain, task, frame.states, parents, portions, may_end)
+        nodes += len(picked)
+        paths = frame.path[parents].copy()
+        if frame.depth < MAX_PORTIONS:
+            paths[:, frame.depth] = portions
+        for i in np.nonzero(~reply.failed & may_end)[0]:
+            if limits.counts_program(int(cost_ended[i])) and reply.solved[i]:
+                limits.found(int(cost_ended[i]), paths[i])
+        if progress:
+            progress(len(picked))
+        live = ~reply.failed & (cost + chain.min_rest[tokens, np.maximum(syntax, 0)] <= limits.cutoff) & (syntax >= 0)
+        if frame.depth + 1 < MAX_PORTIONS:
+            rows = np.nonzero(live)[0]
+            for part in np.array_split(rows, max(1, -(-len(rows) // chunk))):  # chunks of at most `chunk`
+                if len(part):
+                    frames.append(_Frame(backend.take(reply.states, part), tokens[part], syntax[part], cost[part],
+                                         paths[part], frame.depth + 1))
+    return Outcome(limits.best, nodes, limits.programs, limits.b_star, limits.counts)
+
+
+def _children(chain: Chain, frame: _Frame, cutoff: int) -> _Children:
+    """Every syntactic child of the frame's prefixes that may complete under the cutoff,
+    the most probable first (ties in parent, then portion order)."""
+    tokens = chain.tok[None, :]
+    cost = frame.cost[:, None] + chain.trans_bins[frame.last_token[:, None], tokens] + chain.argbins[None, :]
+    syntax = chain.next_syn[tokens, frame.syntax[:, None]]
+    bound = cost + chain.min_rest[tokens, np.maximum(syntax, 0)]
+    parent, portion = np.nonzero((syntax >= 0) & (bound <= cutoff))
+    order = np.argsort(cost[parent, portion], kind="stable")
+    parent, portion = parent[order], portion[order]
+    return _Children(parent, portion, cost[parent, portion], bound[parent, portion])
+
+
+def _next_slice(frame: _Frame, cutoff: int, size: int) -> np.ndarray | None:
+    """The next up to `size` children not yet run that are still under the cutoff (it
+    may have dropped since the children were made), or None when none is left."""
+    pending = np.nonzero(frame.children.bound[frame.next_child :] <= cutoff)[0] + frame.next_child
+    if len(pending) == 0:
+        return None
+    picked = pending[:size]
+    frame.next_child = int(picked[-1]) + 1
+    return picked

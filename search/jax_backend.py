@@ -1,0 +1,304 @@
+"""The search's backend on the JAX emulator: many concepts' children stepped together,
+one device call per instruction.
+
+The concepts being searched have their example scenes and targets in a bank of
+`width` slots on the device (a fixed shape: each instruction compiles once whatever the
+number of concepts); a batch's rows are programs, each reading its concept's slot.
+On the host a prefix's states are one packed int32 row per example (`search.packing`),
+so a frame is one array and a transfer one copy. A request's children are stepped
+atom by atom (a subroutine is several), each atom's rows grouped by instruction; a
+closed loop's further iterations are replayed on the host's command one body
+instruction at a time (`_replay_loops`). Complete programs are judged on the device.
+
+This module is the only part of the search that reads the machine state's fields
+(the section "the machine state's fields" below).
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Sequence
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from search.backend import Reply, Request
+from search.device_calls import DeviceCalls, Pending
+from search.packing import blackboard_columns, pack_state, packed_field, unpack_blackboard, unpack_state
+from search.stepping import EMPTY_HANDED, loop_needs_iteration, replay_examples, step_examples
+from search.task import Task
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.instructions import OP
+from vccjax.machine.match import ASK, YES, Target, verdict
+from vccjax.machine.scene import scenes_match
+from vccjax.machine.state import SceneConst, VCCState, init_state, output_scene
+
+
+# ---- the machine state's fields: the only places the search reads them ----------------
+def _failed_anywhere(states: VCCState) -> jax.Array:
+    """(B,) whether each program of (B, E) states failed on some example (traced)."""
+    return jnp.any(states.control.failed, axis=1)
+
+
+def _failed_rows(packed: np.ndarray, rows: np.ndarray, cfg: VCCConfig) -> np.ndarray:
+    """(len(rows),) whether packed rows `rows` failed on some example."""
+    return packed_field(packed, "control.failed", cfg)[rows].any(axis=1)
+
+
+def _holding_rows(packed: np.ndarray, rows: np.ndarray, cfg: VCCConfig) -> np.ndarray:
+    """(len(rows),) whether some example of packed rows `rows` holds an object."""
+    return (packed_field(packed, "hand.held", cfg)[rows] >= 0).any(axis=1)
+
+
+def _loop_bodies(packed: np.ndarray, cfg: VCCConfig) -> tuple[np.ndarray, ...]:
+    """Of packed rows with a just-closed loop: its body's ops and args (n, L), length and
+    first pc (n,) (the same on every example: read on the first)."""
+    control = unpack_state(packed, cfg).control
+    return control.body_ops[:, 0], control.body_args[:, 0], control.body_len[:, 0], control.body_pc0[:, 0]
+
+
+def _blackboards(packed: np.ndarray, cfg: VCCConfig) -> np.ndarray:
+    """The leading columns of packed rows that output matching reads."""
+    return packed[:, :, : blackboard_columns(cfg)]
+
+
+# ---- device functions ---------------------------------------------------------------
+@functools.partial(jax.jit, static_argnums=0)
+def _device_verdicts(cfg: VCCConfig, consts: SceneConst, targets: Target, slots, boards):
+    """Verdicts (B, E) of packed states (their blackboard columns suffice), row b against
+    the outputs of the task in bank slot `slots[b]`."""
+    def row(slot, s):
+        c, t = jax.tree.map(lambda a: a[slot], (consts, targets))
+        return jax.vmap(functools.partial(verdict, cfg))(c, s, t)
+
+    return jax.vmap(row)(slots, unpack_blackboard(boards, cfg))
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1, 6))
+def _advance(cfg: VCCConfig, op: int, consts: SceneConst, slots, packed, args, replay: bool = True):
+    """Step (B, E) packed states, each row a program of the task in slot `slots[row]`, by
+    `op`; return them and whether each program failed on any example."""
+    new = step_examples(cfg, op, consts, slots, unpack_state(packed, cfg), args, replay)
+    return pack_state(new, cfg), _failed_anywhere(new)
+
+
+@functools.partial(jax.jit, static_argnums=(0, 1))
+def _replay_op(cfg: VCCConfig, op: int, consts: SceneConst, slots, packed, args, pcs, active):
+    """`replay_examples` on packed states."""
+    return pack_state(replay_examples(cfg, op, consts, slots, unpack_state(packed, cfg), args, pcs, active), cfg)
+
+
+@functools.lru_cache(maxsize=None)
+def _packed_root(cfg: VCCConfig) -> np.ndarray:
+    return np.asarray(pack_state(init_state(cfg), cfg))
+
+
+@functools.partial(jax.jit, donate_argnums=0)
+def _put_in_slot(bank, slot, item):
+    """`item` into slot `slot` of every leaf of `bank` (one compiled update, not one per leaf)."""
+    return jax.tree.map(lambda b, a: b.at[slot].set(a), bank, item)
+
+
+def _atoms(requests: Sequence[Request]) -> tuple[np.ndarray, np.ndarray]:
+    """Every child's portion as atoms: ops (n, atoms) -1 padded, args (n, atoms) 0 padded."""
+    atoms = max(r.chain.op_mat.shape[1] for r in requests)
+
+    def padded(m: np.ndarray) -> np.ndarray:
+        return np.pad(m, ((0, 0), (0, atoms - m.shape[1])), constant_values=-1)
+
+    ops = np.concatenate([padded(r.chain.op_mat[r.portions]) for r in requests])
+    args = np.maximum(np.concatenate([padded(r.chain.arg_mat[r.portions]) for r in requests]), 0)
+    return ops, args
+
+
+class JaxBackend:
+    """The `search.backend.Backend` on the JAX emulator; one instance keeps its compiled
+    steps and its bank of up to `width` tasks."""
+
+    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, buckets: Sequence[int] = (16, 64, 256, 1024, 4096),
+                 width: int = 32, devices: Sequence[jax.Device] | None = None):
+        self.cfg = cfg
+        self.calls = DeviceCalls(buckets, devices)  # every batch split by rows over these devices
+        self.width = width  # bank slots: tasks run at once
+        self._bank: tuple[SceneConst, Target] | None = None  # (width, E, ...), a copy on each device
+        self._bank_examples = 0  # E of the bank
+        self._slot_of: dict[int, int] = {}  # id(task) -> bank slot
+        self._room: np.ndarray | None = None  # see `_children_room`
+
+    @property
+    def compile_seconds(self) -> float:
+        return self.calls.compile_seconds
+
+    # ---- the backend interface ----------------------------------------------------------
+    def root_states(self, task: Task) -> np.ndarray:
+        root = _packed_root(self.cfg)
+        return np.broadcast_to(root, (1, task.n_examples) + root.shape).copy()
+
+    def take(self, states: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        return states[rows]
+
+    def admit(self, task: Task, alongside: Sequence[Task]) -> None:
+        """`task` takes the first bank slot that none of `alongside` holds."""
+        used = {self._slot_of.get(id(t)) for t in alongside}
+        self._load(next(k for k in range(self.width) if k not in used), task)
+
+    def apply_many(self, requests: Sequence[Request]) -> list[Reply]:
+        """Every request's children stepped together: one group per instruction across all
+        requests, atom by atom; then the children that may end judged together."""
+        sizes = [len(r.portions) for r in requests]
+        bounds = np.cumsum([0] + sizes)
+        owner = np.repeat(np.arange(len(requests)), sizes)  # (n,) the request of each child
+        parents, parent_row = self._parents(requests)
+        children = self._children_room((len(owner),) + parents.shape[1:], parents.dtype)  # filled atom by atom
+        slots = np.array([self._slot_of[id(r.task)] for r in requests], np.int32)[owner]
+        ops, args = _atoms(requests)
+        failed = np.zeros(len(owner), bool)
+        for k in range(ops.shape[1]):  # every child's k-th atom (portions are -1 padded)
+            source, source_row = (parents, parent_row) if k == 0 else (children, np.arange(len(owner)))
+            self._step_atoms(ops[:, k], np.ascontiguousarray(args[:, k]), slots, source, source_row, children,
+                             failed)
+        may_end = np.concatenate([r.may_end for r in requests])
+        solved = self._judge(requests, owner, slots, children, np.nonzero(may_end & ~failed)[0], failed)
+        return [Reply(children[a:b], failed[a:b], solved[a:b]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+    # ---- the bank of tasks' scenes ---------------------------------------------------------
+    def _load(self, slot: int, task: Task) -> None:
+        """Put a task's scenes and targets in a bank slot (a new bank if the example count
+        differs from the current one's)."""
+        everywhere = self.calls.everywhere
+        if self._bank is None or self._bank_examples != task.n_examples:
+            self._bank = jax.device_put(jax.tree.map(lambda a: jnp.broadcast_to(a, (self.width,) + a.shape),
+                                                     (task.consts, task.targets)), everywhere)
+            self._bank_examples = task.n_examples
+            self._slot_of = {}
+        self._bank = _put_in_slot(self._bank, slot, jax.device_put((task.consts, task.targets), everywhere))
+        self._slot_of = {k: v for k, v in self._slot_of.items() if v != slot}
+        self._slot_of[id(task)] = slot
+
+    # ---- stepping -------------------------------------------------------------------------
+    @staticmethod
+    def _parents(requests: Sequence[Request]) -> tuple[np.ndarray, np.ndarray]:
+        """The states the children start from, each parent once (a frame's parent has many
+        children spread over many rounds: copying a state per child would copy it many
+        times), and each child's row in them."""
+        states, rows, offset = [], [], 0
+        for r in requests:
+            used, row = np.unique(r.parents, return_inverse=True)
+            states.append(r.states[used])
+            rows.append(row.reshape(-1) + offset)
+            offset += len(used)
+        return np.concatenate(states), np.concatenate(rows)
+
+    def _step_atoms(self, ops: np.ndarray, args: np.ndarray, slots: np.ndarray, source: np.ndarray,
+                    source_row: np.ndarray, children: np.ndarray, failed: np.ndarray) -> None:
+        """Step each child not yet failed by its atom `ops[i]` (none where -1), from state
+        `source[source_row[i]]` into `children[i]`; mark `failed` (both in place)."""
+        runs = (ops >= 0) & ~failed
+        groups = {int(op): np.nonzero((ops == op) & ~failed)[0] for op in np.unique(ops[runs])}
+        pending = [self._start_step(op, slots, source, source_row, rows, args) for op, rows in groups.items()]
+        for group in pending:  # every group started before any is waited for
+            for rows, (new, fails) in self.calls.results(group):
+                children[rows] = new
+                failed[rows] |= fails
+        closed = groups.get(OP["loop_end"])
+        if closed is not None:
+            closed = closed[~failed[closed]]
+            self._replay_loops(slots, children, closed)
+            failed[closed] |= _failed_rows(children, closed, self.cfg)
+
+    def _start_step(self, op: int, slots: np.ndarray, source: np.ndarray, source_row: np.ndarray,
+                    rows: np.ndarray, args: np.ndarray) -> Pending:
+        """Start stepping rows `rows` of the batch by `op`, row i's state being
+        `source[source_row[i]]` (packed, (n, E, P)); see `DeviceCalls.start`."""
+        cfg, (consts, _) = self.cfg, self._bank
+        replay_in_step = op != OP["loop_end"]  # a closed loop's further iterations: `_replay_loops`
+        pending = []
+        for part in self._holding_parts(op, source, source_row[rows], rows):
+            pending += self.calls.start(
+                ("step", op, source.shape[1]), part,
+                lambda rows_of: _advance(cfg, op, consts, rows_of(slots), rows_of(source, source_row), rows_of(args),
+                                         replay_in_step))
+        return pending
+
+    def _holding_parts(self, op: int, source: np.ndarray, source_rows: np.ndarray,
+                       rows: np.ndarray) -> list[np.ndarray]:
+        """`rows` split into those where some example holds an object (their states are
+        `source[source_rows]`) and the rest, for a carry op (the rest then skip the carry:
+        `stepping.EMPTY_HANDED`)."""
+        if op not in EMPTY_HANDED:
+            return [rows]
+        holding = _holding_rows(source, source_rows, self.cfg)
+        return [part for part in (rows[holding], rows[~holding]) if len(part)]
+
+    def _replay_loops(self, slots: np.ndarray, states: np.ndarray, rows: np.ndarray) -> None:
+        """A closed loop's remaining iterations for `states[rows]`, one body instruction at a
+        time, each group of programs stepped with that instruction's code only (in place)."""
+        cfg = self.cfg
+        body_ops, body_args, body_len, body_pc0 = _loop_bodies(states[rows], cfg)  # fixed once closed
+        active = np.zeros(states.shape[:2], bool)  # (all rows, E)
+        args = np.zeros(len(states), np.int32)  # this body position's, read at `rows` only
+        pcs = np.zeros(len(states), np.int32)
+        iteration = 1
+        while True:
+            active[rows] = loop_needs_iteration(cfg, unpack_state(states[rows], cfg), iteration)  # host
+            iterating = active[rows].any(axis=1)
+            if not iterating.any():
+                return
+            for j in range(int(body_len[iterating].max())):
+                live = iterating & (body_len > j)
+                pending = []  # the groups of body position j, all started before any is waited for
+                for op in np.unique(body_ops[live, j]):
+                    group = np.nonzero(live & (body_ops[:, j] == op))[0]
+                    args[rows[group]], pcs[rows[group]] = body_args[group, j], body_pc0[group] + j
+                    for part in self._holding_parts(int(op), states, rows[group], rows[group]):
+                        pending += self._start_replay(slots, states, int(op), part, args, pcs, active)
+                for done_rows, new in self.calls.results(pending):
+                    states[done_rows] = new
+            iteration += 1
+
+    def _start_replay(self, slots: np.ndarray, states: np.ndarray, op: int, rows: np.ndarray, args: np.ndarray,
+                      pcs: np.ndarray, active: np.ndarray) -> Pending:
+        cfg, (consts, _) = self.cfg, self._bank
+        return self.calls.start(
+            ("replay", op, active.shape[1]), rows,
+            lambda rows_of: _replay_op(cfg, op, consts, rows_of(slots), rows_of(states), rows_of(args), rows_of(pcs),
+                                       rows_of(active)))
+
+    def _children_room(self, shape: tuple, dtype) -> np.ndarray:
+        """Room for a round's children, reused from round to round (a fresh array each round
+        cost as much in page faults as the copies into it). The search copies what it keeps
+        (`take`) before the next round, so nothing outlives the round."""
+        size = int(np.prod(shape))
+        if self._room is None or self._room.size < size or self._room.dtype != dtype:
+            self._room = np.empty(max(size, 2 * (0 if self._room is None else self._room.size)), dtype)
+        return self._room[:size].reshape(shape)
+
+    # ---- judging --------------------------------------------------------------------------
+    def _judge(self, requests: Sequence[Request], owner: np.ndarray, slots: np.ndarray, children: np.ndarray,
+               judged: np.ndarray, failed: np.ndarray) -> np.ndarray:
+        """(n,) whether each child explains every example of its task: rows `judged` on the
+        device (YES / NO / ASK), an ASK settled on the host."""
+        cfg, examples = self.cfg, children.shape[1]
+        verdicts = np.zeros((len(children), examples), np.int32)
+        if len(judged):
+            consts, targets = self._bank
+            boards = _blackboards(children, cfg)
+            for rows, found in self.calls.run(
+                    ("judge", examples), judged,
+                    lambda rows_of: _device_verdicts(cfg, consts, targets, rows_of(slots), rows_of(boards))):
+                verdicts[rows] = found
+        solved = ~failed & np.all(verdicts == YES, axis=1)
+        for i in np.nonzero(~failed & ~solved & np.all((verdicts == YES) | (verdicts == ASK), axis=1))[0]:
+            solved[i] = self._settle(requests[owner[i]].task, children, int(i), verdicts[i])
+        return solved
+
+    def _settle(self, task: Task, states: np.ndarray, row: int, verdicts: np.ndarray) -> bool:
+        """Rare: two same-looking objects within tau of one target; match on the host."""
+        for e, (_, output) in enumerate(task.pairs):
+            if verdicts[e] == ASK:
+                consts = jax.tree.map(lambda a: a[e], task.consts)  # noqa: B023
+                state = unpack_state(states[row, e], self.cfg)
+                if not scenes_match(output_scene(consts, state, self.cfg), output, self.cfg.tau):
+                    return False
+        return True
