@@ -101,27 +101,12 @@ def end_to_end(
 
     `misses` lists every concept with a disagreeing pair and those pairs' indices, so
     that a miss can be replayed (`render(inp, size, style, seed=1000 * index + k)`)."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    from tqdm import tqdm
-
+    from vccjax.parallel import map_with_progress
     from vccjax.world.dataset import Dataset
 
     names = concepts or Dataset(folder).concepts
     jobs = [(str(folder), n, style, pairs, size) for n in names]
-    bar = tqdm(total=len(jobs), desc=f"end to end ({style})", disable=not progress)
-    results = []
-    if workers > 1:  # spawn, not fork: the parent may have started JAX's threads
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-            for r in pool.map(_concept_end_to_end, jobs, chunksize=2):
-                results.append(r)
-                bar.update()
-    else:
-        for job in jobs:
-            results.append(_concept_end_to_end(job))
-            bar.update()
-    bar.close()
+    results = map_with_progress(_concept_end_to_end, jobs, workers, 2, f"end to end ({style})", progress)
     share = {n: 1 - len(miss) / max(total, 1) for n, total, miss in results}
     return {
         "style": style, "concepts": len(results), "pairs_per_concept": pairs,

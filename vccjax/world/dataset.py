@@ -169,10 +169,7 @@ def build_dataset(
     cfg: VCCConfig = DEFAULT_CONFIG, workers: int = 0, progress: bool = True,
 ) -> dict:
     """Build (or resume building) the dataset under `out`; returns the manifest."""
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    from tqdm import tqdm
+    from vccjax.parallel import map_with_progress
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -182,18 +179,7 @@ def build_dataset(
     if unknown:
         raise DataFileError(f"unknown concept(s): {', '.join(unknown[:5])}")
     jobs = [(n, names.index(n), seed, cfg, str(out)) for n in wanted]
-    results = []
-    bar = tqdm(total=len(jobs), desc="concepts", unit="concept", disable=not progress)
-    if workers > 1:  # spawn, not fork: the parent may have started JAX's threads
-        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-            for r in pool.map(_build_one, jobs, chunksize=4):
-                results.append(r)
-                bar.update()
-    else:
-        for job in jobs:
-            results.append(_build_one(job))
-            bar.update()
-    bar.close()
+    results = map_with_progress(_build_one, jobs, workers, 4, "concepts", progress, unit="concept")
     manifest = {
         "format": FORMAT, "version": VERSION, "seed": seed,
         "config": {"raster": cfg.raster, "n_max": cfg.n_max},
