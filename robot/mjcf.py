@@ -20,7 +20,6 @@ from robot.world import APART, BODIES, TABLE_CENTRE, TABLE_HALF, TEXTURES, WORKS
 
 ARM_JOINTS = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
 HOME = (-1.5708, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)  # tool down, beside the workspace
-PARK = (3.1416, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)  # tool down behind the base: out of the camera's view
 FINGER_OPEN = 0.045  # metres each finger travels from the centre: 9 cm between the pads
 TCP_DEPTH = 0.115  # tool centre point below the flange, 1.5 cm above the pads' tips
 PAD_HALF = (0.006, 0.011, 0.040)  # pad half extents: thickness (closing axis), width, length

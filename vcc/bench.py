@@ -10,14 +10,14 @@ import json
 import os
 import platform
 import subprocess
-import sys
 import time
 from collections import Counter
 from pathlib import Path
 
 
-def stamp() -> dict:
-    """Where and when a measurement was made."""
+def stamp(a: argparse.Namespace, benchmark: str) -> dict:
+    """Where and when a measurement was made, and the command that made it (rebuilt from the
+    parsed settings, so a bench called from Python is stamped as truly as one from the shell)."""
     import jax
 
     cpu = platform.processor()
@@ -35,10 +35,22 @@ def stamp() -> dict:
         commit = None
     return {
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "commit": commit, "command": "vcc " + " ".join(sys.argv[1:]) if sys.argv else None,
+        "commit": commit, "command": command_line(a, benchmark),
         "machine": {"cores": os.cpu_count(), "cpu": cpu, "python": platform.python_version(),
                     "jax": jax.__version__, "devices": [str(d) for d in jax.devices()]},
     }
+
+
+
+def command_line(a: argparse.Namespace, benchmark: str) -> str:
+    """The `vcc bench` command that reproduces a run: its parsed options, in order."""
+    parts = ["vcc", "bench", benchmark]
+    for k, v in vars(a).items():
+        if k in ("fn", "command", "action") or v is None or v is False:
+            continue
+        flag = "--" + k.replace("_", "-")
+        parts += [flag] if v is True else [flag, str(v)]
+    return " ".join(parts)
 
 
 def _search_jobs(a: argparse.Namespace):
@@ -96,7 +108,7 @@ def cmd_bench_search(a: argparse.Namespace) -> int:
     agree = all((batched[j].found, batched[j].text, batched[j].rank) == (scalar[j].found, scalar[j].text,
                                                                          scalar[j].rank) for j in range(len(jobs)))
     report = {
-        **stamp(), "benchmark": "search", "concepts": names, "budget": a.budget, "model": a.model,
+        **stamp(a, "search"), "benchmark": "search", "concepts": names, "budget": a.budget, "model": a.model,
         "args": "oracle", "width": a.width, "found": sum(r.found for r in batched.values()),
         "batched": {**rates(batched, jax_s), "first_run_seconds_with_compile": round(first, 2)},
         "scalar": rates(scalar, scalar_s), "results_agree": agree,
@@ -153,7 +165,7 @@ def cmd_bench_emulator(a: argparse.Namespace) -> int:
         sweeps["objects"].append({"objects": n, **run(scenes, DEFAULT_CONFIG, batches[0])})
     for r in rasters:
         sweeps["raster"].append({"raster": r, **run(examples, VCCConfig(raster=r), batches[0])})
-    report = {**stamp(), "benchmark": "emulator", "concepts": names, "model": "reference",
+    report = {**stamp(a, "emulator"), "benchmark": "emulator", "concepts": names, "model": "reference",
               "stream": {"programs": len(stream), "per_concept": a.per_concept, "record_seconds": round(record_s, 2),
                          "instructions": dict(ops.most_common())},
               "main": main, "sweeps": sweeps}
@@ -214,7 +226,7 @@ def cmd_bench_reproduce(a: argparse.Namespace) -> int:
 def _write_report(a: argparse.Namespace, runs: Path) -> int:
     from vcc import report
 
-    st = stamp()
+    st = stamp(a, "reproduce")
     rows = report.collect_rows(runs)
     out = Path(a.out)
     out.parent.mkdir(parents=True, exist_ok=True)

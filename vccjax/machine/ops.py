@@ -1,4 +1,4 @@
-"""The instructions' semantics in JAX (docs/vcc.md section 3, in the order of its table).
+"""The instructions' semantics in JAX (docs/vcc.md section 3, grouped by the memory each acts on, in the order of its table).
 
 Each `op_<name>(cfg, c, s, arg)` is pure and returns (new state, failed?); `step.py`
 keeps the old state when an op fails and records where. The scalar reference
@@ -79,7 +79,7 @@ def _hand(s: VCCState, **fields) -> VCCState:
     return s.replace(hand=s.hand.replace(**fields))
 
 
-# ---- instructions (docs/vcc.md section 3, in the order of its table) -------------------------
+# ---- instructions (docs/vcc.md section 3, grouped by the memory each acts on, in the order of its table) -------------------------
 def op_scene_parse(cfg, c, s, arg):
     n, b = cfg.n_max, s.blackboard
     return s.replace(blackboard=b.replace(

@@ -32,8 +32,8 @@ from vccjax.world.rivals import rival_programs
 from vccjax.machine.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
-VERSION = 8  # 2: examples must be well posed (examples.Jitter); 3: small nudges too;
-# 4: drawn shapes kept apart (generate.drawn_cover), whole-scene and pointer nudges; 5: each object nudged alone;
+VERSION = 8  # 2: examples must be well posed (pairs.Jitter); 3: small nudges too;
+# 4: drawn shapes kept apart (scenes.drawn_cover), whole-scene and pointer nudges; 5: each object nudged alone;
 # 6: training pairs tell the reference from its rivals (rivals.py); rivals left untold are listed per concept;
 # 7: every loop of a program (not only the first) gets the straight-pass rivals;
 # 8: rivals TRAIN's scenes leave untold get a second chance on the test's wider range (TRAIN_WIDE)

@@ -10,7 +10,7 @@ on every training pair:
   and a circle).
 
 The training split is therefore made to tell the reference from every rival listed
-here (`examples.discriminate`): each rival fails, or gives another output, on at
+here (`pairs.discriminate`): each rival fails, or gives another output, on at
 least one training pair. The rivals are simple edits of the reference: one
 instruction deleted (but a last `release_object`), each loop run as one or two
 straight passes (each loop of the six concepts with two loops in turn, the other left

@@ -13,7 +13,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from conftest import agree, same_jax
+from tests.helpers import agree, same_jax
 
 from vccjax.machine import step as emulator
 from vccjax.machine.config import DEFAULT_CONFIG as CFG

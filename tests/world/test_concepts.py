@@ -7,7 +7,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from conftest import agree, obj, run_both, scene
+from tests.helpers import agree, obj, run_both, scene
 
 from vccjax.machine import step as emulator
 from vccjax.world.concepts import LICENSE, all_concepts, concept_names, reference_program

@@ -202,7 +202,7 @@ def test_importing_mjx_does_not_print_that_the_optional_warp_is_missing():
 
     code = "import robot.control, mujoco.mjx.warp as w; print('warp installed:', w.WARP_INSTALLED)"
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
-                       cwd=Path(__file__).parent.parent)
+                       cwd=Path(__file__).parents[2])
     assert r.returncode == 0, r.stderr
     have_warp = importlib.util.find_spec("warp") is not None
     assert r.stdout == f"warp installed: {have_warp}\n" and "Failed to import" not in r.stderr, (r.stdout, r.stderr)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 
-from vcc.cli import main
+from vcc.cli import build_parser, main
 
 
 def test_bench_search_compares_batched_and_scalar_on_the_same_concepts(tmp_path, capsys):
@@ -20,6 +20,9 @@ def test_bench_search_compares_batched_and_scalar_on_the_same_concepts(tmp_path,
     assert r["batched"]["nodes"] == r["scalar"]["nodes"]
     assert r["ratio"] > 0 and f"{r['ratio']}x" in text
     assert {"date", "commit", "machine", "command"} <= set(r) and r["machine"]["cores"] >= 1
+    again = build_parser().parse_args(r["command"].split()[1:])  # the stamped command reproduces the run
+    assert {k: v for k, v in vars(again).items() if k != "fn"} == {
+        k: v for k, v in vars(build_parser().parse_args(argv)).items() if k != "fn"}
 
 
 def test_bench_emulator_steps_a_recorded_search_stream_on_both_machines(tmp_path, capsys):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from conftest import obj, scene
+from tests.helpers import obj, scene
 
 from vccjax.machine.config import VCCConfig
 from vccjax.errors import ProgramSyntaxError, SceneError

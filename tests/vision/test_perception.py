@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import obj, scene
+from tests.helpers import obj, scene
 
 from vccjax.machine.config import DEFAULT_CONFIG as CFG
 from vccjax.errors import SceneError
