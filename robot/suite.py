@@ -44,16 +44,14 @@ def induced_programs(run: str | Path) -> dict:
 
 
 def programs_of(name: str, induced: str | Path | None = None):
-    """A concept's program: the reference one, or the one a `vcc induce` run in folder
-    `induced` found; for A+B, A's then B's (run on the scene A leaves)."""
-    from vccjax.world.concepts import concept_names, reference_program
+    """A concept's program: the reference one (or, for a concept learned with `vcc learn
+    --save`, the program saved in the user's library), or the one a `vcc induce` run in
+    folder `induced` found; for A+B, A's then B's (run on the scene A leaves)."""
+    from vccjax.world.user_concepts import concept_program
 
     parts = name.split("+")
-    unknown = [c for c in parts if c not in concept_names()]
-    if unknown:
-        raise ValueError(f"unknown concept {', '.join(map(repr, unknown))} (see `vcc concepts`)")
-    if induced is None:
-        programs = [reference_program(c) for c in parts]
+    if induced is None:  # a shipped concept's reference program, or one the user saved
+        programs = [concept_program(c) for c in parts]
     else:
         found = induced_programs(induced)
         missing = [c for c in parts if c not in found]

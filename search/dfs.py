@@ -58,16 +58,31 @@ class _Frame:
     next_child: int = 0  # children before this one have been run
 
 
+class Alternatives(NamedTuple):
+    """Also keep other programs that explain every example (the rivals `vcc learn` asks
+    about): at most `keep`, the cheapest, costing at most `margin_bins` more than the
+    best, found within `extra_programs` programs judged after the first fit. The best
+    program is the one the plain search finds: the extra search only keeps the cutoff
+    higher for a while, and a program replaces the best only when strictly cheaper."""
+
+    margin_bins: int
+    keep: int
+    extra_programs: int
+
+
 class _Budget:
     """The cutoff and the programs counted against the budget, as the search lowers it."""
 
-    def __init__(self, chain: Chain, budget: int):
+    def __init__(self, chain: Chain, budget: int, alternatives: Alternatives | None = None):
         self.b_star, self.counts = cutoff_for_budget(chain, budget)
         cheaper = int(self.counts[self.b_star - 1]) if self.b_star > 0 else 0
         self.quota = budget - cheaper  # programs of cost exactly b* still allowed
         self.cutoff = self.b_star  # the most a program may cost (bins)
         self.programs = 0  # complete programs counted
         self.best: tuple[int, np.ndarray] | None = None
+        self.alternatives = alternatives
+        self.fits: list[tuple[int, np.ndarray]] = []  # every fit, kept only with alternatives
+        self.extra_left = alternatives.extra_programs if alternatives else 0
 
     def counts_program(self, cost: int) -> bool:
         """Count a complete program that ran on every example; False if it lies beyond the
@@ -79,21 +94,50 @@ class _Budget:
             if self.quota == 0:
                 self.cutoff = min(self.cutoff, self.b_star - 1)
         self.programs += 1
+        if self.best is not None and self.extra_left > 0:
+            self.extra_left -= 1
+            if self.extra_left == 0:  # the extra search is spent: only cheaper programs from now on
+                self.cutoff = min(self.cutoff, self.best[0] - 1)
         return True
 
     def found(self, cost: int, path: np.ndarray) -> None:
         """A program that explains every example: keep it if it is the cheapest so far."""
+        fit = (cost, path.copy())
+        if self.alternatives is not None:
+            self.fits.append(fit)
         if self.best is None or cost < self.best[0]:
-            self.best = (cost, path.copy())
-            self.cutoff = min(self.cutoff, cost - 1)
+            self.best = fit
+        self.cutoff = min(self.cutoff, self._limit())
+
+    def _limit(self) -> int:
+        """The cutoff a found program allows: below the best, or with alternatives wanted,
+        up to the margin above it until `keep` of them are in hand."""
+        best = self.best[0]
+        alt = self.alternatives
+        if alt is None or self.extra_left <= 0:
+            return best - 1
+        costs = sorted(c for c, _ in self.fits if c <= best + alt.margin_bins)
+        if len(costs) >= alt.keep:
+            return min(best + alt.margin_bins, costs[alt.keep - 1] - 1)
+        return best + alt.margin_bins
+
+    def kept(self) -> tuple[tuple[int, np.ndarray], ...]:
+        """The alternatives kept, cheapest first (ties in finding order), the best excluded."""
+        if self.best is None or self.alternatives is None:
+            return ()
+        best, alt = self.best, self.alternatives
+        others = [f for f in self.fits if f is not best and f[0] <= best[0] + alt.margin_bins]
+        others = sorted(others, key=lambda f: f[0])  # stable: ties keep finding order
+        return tuple(others[: max(alt.keep - 1, 0)])
 
 
 def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chunk: int, slice_size: int,
-                progress: Callable[[int], None] | None = None) -> Generator[Request, Reply, Outcome]:
+                progress: Callable[[int], None] | None = None,
+                alternatives: Alternatives | None = None) -> Generator[Request, Reply, Outcome]:
     """The search of one concept as a coroutine: yields a `Request` for each slice of up
     to `slice_size` children, receives the backend's `Reply`; returns the `Outcome`.
     `backend` is used for root states and `take` only (the caller applies the requests)."""
-    limits = _Budget(chain, budget)
+    limits = _Budget(chain, budget, alternatives)
     frames = [_Frame(backend.root_states(task), np.array([chain.end]), np.array([NOT_STARTED]), np.array([0]),
                      np.full((1, MAX_PORTIONS), -1, np.int32), 0)]
     nodes = 0
@@ -128,7 +172,7 @@ def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chun
                 if len(part):
                     frames.append(_Frame(backend.take(reply.states, part), tokens[part], syntax[part], cost[part],
                                          paths[part], frame.depth + 1))
-    return Outcome(limits.best, nodes, limits.programs, limits.b_star, limits.counts)
+    return Outcome(limits.best, nodes, limits.programs, limits.b_star, limits.counts, limits.kept())
 
 
 def _children(chain: Chain, frame: _Frame, cutoff: int) -> _Children:

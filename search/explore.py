@@ -26,14 +26,14 @@ import numpy as np
 from search.backend import Backend, Reply, Request
 from search.chain import Chain
 from search.device_calls import RowsOf
-from search.dfs import MAX_PORTIONS, depth_first
+from search.dfs import MAX_PORTIONS, Alternatives, depth_first
 from search.jax_backend import JaxBackend
 from search.lockstep import search_in_lockstep
 from search.result import Result, result_of
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 
-__all__ = ["MAX_PORTIONS", "Backend", "Explorer", "Reply", "Request", "Result", "Searcher", "Task"]
+__all__ = ["MAX_PORTIONS", "Alternatives", "Backend", "Explorer", "Reply", "Request", "Result", "Searcher", "Task"]
 
 
 class Searcher:
@@ -47,13 +47,14 @@ class Searcher:
         self.width = width
 
     def search(self, chain: Chain, task: Task, budget: int,
-               progress: Callable[[int], None] | None = None) -> Result:
+               progress: Callable[[int], None] | None = None, alternatives: Alternatives | None = None) -> Result:
         """The shortest program under the budget's cutoff that explains every example;
-        `progress(n)` is told of each slice of n children run."""
+        `progress(n)` is told of each slice of n children run; with `alternatives`, other
+        programs that explain them too (`search.dfs.Alternatives`)."""
         t0, compiled_before = time.perf_counter(), self.backend.compile_seconds
         self.backend.admit(task, [])
         search = depth_first(chain, task, budget, self.backend, chunk=self.chunk, slice_size=self.slice_size,
-                             progress=progress)
+                             progress=progress, alternatives=alternatives)
         try:
             request = next(search)
             while True:
@@ -64,11 +65,11 @@ class Searcher:
                          self.backend.compile_seconds - compiled_before)
 
     def search_many(self, jobs: Sequence[tuple[Chain, Task]], budget: int,
-                    done: Callable[[int, Result], None]) -> None:
+                    done: Callable[[int, Result], None], alternatives: Alternatives | None = None) -> None:
         """Explore every (chain, task) job, `width` at a time in lockstep; `done(index,
         result)` is called as each finishes (`search.lockstep.search_in_lockstep`)."""
         search_in_lockstep(self.backend, jobs, budget, done, width=self.width, chunk=self.chunk,
-                           slice_size=self.slice_size)
+                           slice_size=self.slice_size, alternatives=alternatives)
 
 
 class Explorer(Searcher):

@@ -19,15 +19,14 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 
-from search.chain import Chain, uniform_args
-from search.compress import compress
+from search.arguments import MODES as ARG_MODES
+from search.chain import Chain
 from search.explore import Explorer, Searcher
 from search.model import MarkovModel, Vocabulary
 from search.result import Result
@@ -35,12 +34,9 @@ from search.task import Task
 from vccjax.world.concepts import reference_program
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import DataFileError
-from vccjax.machine.instructions import NAMES, OP, arg_domain
 from vccjax.machine.program import Program, parse
 from vccjax.machine.reference import RefMachine
 from vccjax.machine.scene import Scene, scenes_match
-
-ARG_MODES = ("uniform", "oracle", "uniform+fixation", "predicted", "predicted+fixation")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -63,53 +59,27 @@ class Settings:
             raise ValueError("--budget must be positive")
 
 
-def _uniform_over_used(program: Program, name: str) -> np.ndarray:
-    """log p uniform over the values `program` gives instruction `name`; -inf elsewhere."""
-    used = sorted({a for o, a in zip(program.ops, program.args, strict=True) if o == OP[name]})
-    lp = np.full(len(arg_domain(name)), -np.inf)
-    if used:
-        lp[used] = -math.log(len(used))
-    return lp
+def argument_logp(settings: Settings, concept: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
+                  answer: Program | None = None) -> dict[int, np.ndarray]:
+    """log p(argument | instruction) for one concept under the settings' mode
+    (`search.arguments`); oracle and +fixation read `answer`, by default the concept's
+    reference program when it is one of the 546."""
+    from search.arguments import argument_logp as logp
 
-
-def argument_logp(settings: Settings, concept: str,
-                  pairs: Sequence[tuple[Scene, Scene]] | None = None) -> dict[int, np.ndarray]:
-    """log p(argument | instruction) for one concept under the settings' mode.
-
-    oracle: uniform over the values its reference program uses; an instruction with
-    arguments that the program never uses is left out (what a perfect predictor gives).
-    predicted: `set_shape_attn`, `set_color_attn` and `fill_color` from the argument
-    CNN on the concept's training `pairs` (arguments under 0.55 dropped, an instruction
-    with none left out; `argpred.predict`); `fixate` and `imagine_object` uniform.
-    +fixation: `fixate` takes the teacher's value (the reference program's)."""
-    mode = settings.args
-    out = uniform_args()
-    if mode == "oracle":
-        ref = reference_program(concept)
-        return {OP[name]: _uniform_over_used(ref, name) for name in NAMES if arg_domain(name)}
-    if mode.startswith("predicted"):
-        from argpred.predict import argument_logp as predicted, default_predictor
-
-        if pairs is None:
-            raise ValueError("--args predicted needs the concept's training pairs")
-        for name, lp in predicted(default_predictor().for_pairs(pairs)).items():
-            out[OP[name]] = lp
-    if mode.endswith("+fixation"):
-        out[OP["fixate"]] = _uniform_over_used(reference_program(concept), "fixate")
-    return out
+    if answer is None and (settings.args == "oracle" or settings.args.endswith("+fixation")):
+        answer = reference_program(concept)
+    return logp(settings.args, pairs, answer)
 
 
 def fit_model(programs: Sequence[Program], settings: Settings, with_subroutines: bool):
     """The (vocabulary, Markov model) compression gives for the programs found so far."""
-    seqs = [list(p.ops) for p in programs]
-    vocab = Vocabulary()
-    if with_subroutines and seqs:
-        seqs, vocab, _ = compress(seqs, vocab, order=settings.order, epsilon=settings.epsilon,
-                                  cap=settings.max_subroutines)
-    if not seqs:
-        return vocab, MarkovModel.uniform(vocab.size, settings.order)
-    data = seqs + [list(b) for b in vocab.bodies]
-    return vocab, MarkovModel.fit(data, vocab.size, settings.order, settings.epsilon)
+    from search.library import fit
+
+    if not programs:
+        return Vocabulary(), MarkovModel.uniform(Vocabulary().size, settings.order)
+    vocab, counts = fit([p.ops for p in programs], settings.order, settings.epsilon, settings.max_subroutines,
+                        with_subroutines)
+    return vocab, MarkovModel.from_counts(counts, settings.order, settings.epsilon)
 
 
 def generalization(program: Program, pairs: Sequence[tuple[Scene, Scene]], tau: float) -> int:

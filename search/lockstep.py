@@ -18,7 +18,7 @@ import numpy as np
 
 from search.backend import Backend, Reply, Request
 from search.chain import Chain
-from search.dfs import depth_first
+from search.dfs import Alternatives, depth_first
 from search.result import Outcome, Result, result_of
 from search.task import Task
 
@@ -34,7 +34,8 @@ class _Running:
 
 
 def search_in_lockstep(backend: Backend, jobs: Sequence[tuple[Chain, Task]], budget: int,
-                       done: Callable[[int, Result], None], *, width: int, chunk: int, slice_size: int) -> None:
+                       done: Callable[[int, Result], None], *, width: int, chunk: int, slice_size: int,
+                       alternatives: Alternatives | None = None) -> None:
     """Explore every (chain, task) job, `width` at a time in lockstep; `done(index,
     result)` is called as each finishes (in finishing order). A job's `seconds` and
     `compile_seconds` are its share, by rows stepped, of the rounds it took part in.
@@ -49,7 +50,8 @@ def search_in_lockstep(backend: Backend, jobs: Sequence[tuple[Chain, Task]], bud
         chain, task = jobs[j]
         t0 = time.perf_counter()
         backend.admit(task, [jobs[k][1] for k in running])
-        search = depth_first(chain, task, budget, backend, chunk=chunk, slice_size=slice_size)
+        search = depth_first(chain, task, budget, backend, chunk=chunk, slice_size=slice_size,
+                             alternatives=alternatives)
         try:
             running[j] = _Running(search, next(search), time.perf_counter() - t0, 0.0)
         except StopIteration as stop:  # nothing under the cutoff to run

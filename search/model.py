@@ -101,7 +101,12 @@ class MarkovModel:
 
     @classmethod
     def fit(cls, seqs: Sequence[Sequence[int]], size: int, order: int = 1, epsilon: float = 0.1) -> MarkovModel:
-        counts = transition_counts(seqs, size)
+        return cls.from_counts(transition_counts(seqs, size), order, epsilon)
+
+    @classmethod
+    def from_counts(cls, counts: np.ndarray, order: int = 1, epsilon: float = 0.1) -> MarkovModel:
+        """The MAP model of (size+1, size+1) transition counts (`transition_counts`)."""
+        size = counts.shape[0] - 1
         if order == 0:
             counts = np.broadcast_to(counts.sum(0, keepdims=True), counts.shape)
         elif order != 1:

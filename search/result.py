@@ -14,6 +14,14 @@ from vccjax.machine.instructions import NAMES, arg_domain
 from vccjax.machine.program import Program
 
 
+class Alternative(NamedTuple):
+    """Another program that explains every example (`search.dfs.Alternatives`)."""
+
+    program: Program
+    text: str  # as searched, with subroutine calls
+    dl_nats: float
+
+
 @dataclasses.dataclass
 class Result:
     found: bool
@@ -28,6 +36,7 @@ class Result:
     cutoff_bins: int
     budget: int
     compile_seconds: float = 0.0  # of `seconds`, spent compiling new (op, batch size) steps
+    alternatives: tuple[Alternative, ...] = ()  # other programs that explain every example, when asked for
 
 
 class Outcome(NamedTuple):
@@ -38,6 +47,7 @@ class Outcome(NamedTuple):
     programs: int  # complete programs judged
     cutoff_bins: int  # b*, the budget's cutoff
     counts: np.ndarray  # counts[b]: programs of cost <= b (chain.cutoff_for_budget's table)
+    alternatives: tuple = ()  # (cost, portions) of other fits kept, cheapest first
 
 
 def result_of(chain: Chain, budget: int, outcome: Outcome, seconds: float, compile_seconds: float) -> Result:
@@ -48,8 +58,13 @@ def result_of(chain: Chain, budget: int, outcome: Outcome, seconds: float, compi
     cost, path = outcome.best
     portions = [int(x) for x in path if x >= 0]
     rank = int(outcome.counts[cost - 1]) + 1 if cost > 0 else 1
+    others = []
+    for _, other in outcome.alternatives:
+        steps = [int(x) for x in other if x >= 0]
+        others.append(Alternative(program_of(chain, steps), text_of(chain, steps), chain.program_nats(steps)))
     return Result(True, program_of(chain, portions), text_of(chain, portions), chain.program_nats(portions), cost,
-                  rank, outcome.nodes, outcome.programs, seconds, outcome.cutoff_bins, budget, compile_seconds)
+                  rank, outcome.nodes, outcome.programs, seconds, outcome.cutoff_bins, budget, compile_seconds,
+                  tuple(others))
 
 
 def program_of(chain: Chain, portions: Sequence[int]) -> Program:

@@ -13,6 +13,7 @@ import sys
 from argpred import cli as argpred_cli
 from robot import cli as robot_cli
 from search import cli as search_cli
+from search import learn_cli
 from vcc import bench
 from vccjax import cli as vccjax_cli
 from vccjax import runtime
@@ -27,6 +28,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     vccjax_cli.add_commands(sub)
     search_cli.add_commands(sub)
+    learn_cli.add_commands(sub)
     argpred_cli.add_commands(sub)
     robot_cli.add_commands(sub)
     bench.add_commands(sub)

@@ -14,24 +14,12 @@ from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.views.text import ascii_scene, legend
 
 
-def read_image(path: str):
-    """An image file as RGB uint8, or a one-line error."""
-    import cv2
-
-    if not Path(path).is_file():
-        raise VCCError(f"{path}: no such image file")
-    img = cv2.imread(path, cv2.IMREAD_COLOR)
-    if img is None:
-        raise VCCError(f"{path}: not an image OpenCV can read")
-    return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
-
-
 def program_and_scene(a: argparse.Namespace):
     """(program, scene, note, expected output or None) from the shared flags of `vcc run`
     and `vcc trace`: PROGRAM or --concept; --scene, --image, --example K of the concept,
     or a seeded random scene."""
-    from vccjax.world.concepts import reference_program
     from vccjax.world.scenes import random_scene
+    from vccjax.world.user_concepts import concept_program
     from vccjax.machine.reference import run_reference
     from vccjax.machine.scene import Scene, scenes_match
 
@@ -39,8 +27,8 @@ def program_and_scene(a: argparse.Namespace):
     program = None if a.program is None else runtime.program_from_arg(a.program)
     if program is None:
         if not a.concept:
-            raise VCCError("give a PROGRAM, or --concept NAME to run its reference program")
-        program = reference_program(a.concept)
+            raise VCCError("give a PROGRAM, or --concept NAME to run its program (shipped or saved by vcc learn)")
+        program = concept_program(a.concept)
     given = [f for f, v in (("--scene", a.scene), ("--image", a.image), ("--example", a.example)) if v is not None]
     if len(given) > 1:
         raise VCCError(f"give one of {', '.join(given)}, not several")
@@ -49,13 +37,9 @@ def program_and_scene(a: argparse.Namespace):
     if a.scene:
         return program, Scene.load(a.scene).validate(cfg), f"scene {a.scene}", None
     if a.image:
-        from vccjax.vision.perception import parse_image
+        from vccjax.vision.examples_folder import read_scene
 
-        image = read_image(a.image)
-        try:
-            scene = parse_image(image).validate(cfg)
-        except VCCError as e:
-            raise VCCError(f"{a.image}: {e}") from None
+        scene = read_scene(a.image, cfg, image=True)
         return program, scene, f"image {a.image} ({len(scene.objects)} objects parsed)", None
     if a.example is not None:
         from vccjax.world.dataset import dataset_for
@@ -145,11 +129,13 @@ def cmd_dataset_build(a: argparse.Namespace) -> int:
     import os
     import time
 
+    from vccjax.world.concepts import read_programs
     from vccjax.world.dataset import build_dataset
 
     concepts = None if a.concepts in (None, "all") else [c.strip() for c in a.concepts.split(",") if c.strip()]
+    programs = read_programs(a.programs) if a.programs else None
     start = time.time()
-    m = build_dataset(a.out, concepts, seed=a.seed, workers=a.workers or os.cpu_count() or 1)
+    m = build_dataset(a.out, concepts, seed=a.seed, workers=a.workers or os.cpu_count() or 1, programs=programs)
     print(f"{len(m['concepts'])} concepts written to {a.out} (seed {a.seed}) in {time.time() - start:.0f}s")
     left = m["rivals_left"]
     print(f"training pairs tell every rival of the reference apart in {len(m['concepts']) - len(left)} concepts;"
@@ -234,6 +220,7 @@ def add_commands(sub) -> None:
     dsub = d.add_subparsers(dest="action", required=True, metavar="ACTION")
     b = dsub.add_parser("build", help="generate 10 training and 50 test pairs per concept (resumable)")
     b.add_argument("--concepts", default="all", help="'all' (default) or a comma-separated list")
+    b.add_argument("--programs", help="build your own concepts instead: a file of `name: program` lines")
     b.add_argument("--seed", type=int, default=0, help="seed (default 0); same seed, same bytes")
     b.add_argument("--out", default="data/examples", help="output folder (default data/examples)")
     b.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")

@@ -1,4 +1,4 @@
-"""Spec section 7 on device: does a state's blackboard match an example's output?
+"""docs/vcc.md section 7 on device: does a state's blackboard match an example's output?
 
 `scenes_match` (host) finds a one-to-one matching by shape, colour and centre within
 tau. On device a full matching is not needed: when every object has exactly one

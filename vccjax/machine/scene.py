@@ -122,7 +122,7 @@ def box_inside(x: int, y: int, w: int, cfg: VCCConfig) -> bool:
 
 
 def scenes_match(a: Scene, b: Scene, tau: float) -> bool:
-    """Spec section 7: same object count, matched one to one by shape, color and center within tau."""
+    """docs/vcc.md section 7: same object count, matched one to one by shape, color and center within tau."""
     if len(a.objects) != len(b.objects):
         return False
     n = len(a.objects)

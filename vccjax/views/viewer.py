@@ -40,11 +40,11 @@ def _px(v: float, units: int, size: int) -> int:
     return int(round(v / units * size))
 
 
-def _text(img: np.ndarray, text: str, org: tuple[int, int], color=INK, scale: float = 0.42) -> None:
+def put_text(img: np.ndarray, text: str, org: tuple[int, int], color=INK, scale: float = 0.42) -> None:
     cv2.putText(img, text, org, FONT, scale, color, 1, cv2.LINE_AA)
 
 
-def _fit(text: str, width: int, scale: float = 0.42) -> str:
+def fit_text(text: str, width: int, scale: float = 0.42) -> str:
     """Cut `text` with an ellipsis to fit `width` pixels."""
     while len(text) > 4 and cv2.getTextSize(text, FONT, scale, 1)[0][0] > width:
         text = text[:-4] + "..."
@@ -78,7 +78,7 @@ def _scene_view(m: RefMachine, size: int, input_frame: bool) -> np.ndarray:
         cv2.polylines(img, [np.array(pts, np.int32)], False, GREY, 1, cv2.LINE_AA)
     for k, p in enumerate(pts[1:], 1):
         cv2.circle(img, p, 2, GREY, -1, cv2.LINE_AA)
-        _text(img, str(k), (p[0] + 3, p[1] - 3), GREY, 0.3)
+        put_text(img, str(k), (p[0] + 3, p[1] - 3), GREY, 0.3)
     f = (_px(m.fovea.position[0], u, size), _px(m.fovea.position[1], u, size))
     cv2.circle(img, f, 9, FOVEA, 2, cv2.LINE_AA)
     cv2.line(img, (f[0] - 13, f[1]), (f[0] + 13, f[1]), FOVEA, 1, cv2.LINE_AA)
@@ -86,7 +86,7 @@ def _scene_view(m: RefMachine, size: int, input_frame: bool) -> np.ndarray:
     for rank, i in enumerate(a.attended_list if not a.stale else []):
         if b.alive[i]:
             (x, y), h = m.centre(i), m.widths[i] / 2 * size
-            _text(img, str(rank + 1), (int(_px(x, u, size) + h) + 2, int(_px(y, u, size) - h) + 4), ATTEND, 0.38)
+            put_text(img, str(rank + 1), (int(_px(x, u, size) + h) + 2, int(_px(y, u, size) - h) + 4), ATTEND, 0.38)
     if a.attended >= 0 and b.alive[a.attended]:
         _box(img, m, a.attended, ATTEND, size, 3, 1)
     if m.hand.held >= 0:
@@ -107,27 +107,27 @@ def panel(frame: Frame, size: int = 256) -> np.ndarray:
     cv2.rectangle(img, (MARGIN - 1, HEADER - 1), (MARGIN + size, HEADER + size), (200, 200, 200), 1)  # the workspace
     width = size + 2 * MARGIN - 8
     if input_frame:
-        _text(img, "input scene", (4, 14), INK, 0.45)
+        put_text(img, "input scene", (4, 14), INK, 0.45)
     else:
         loop = f", iteration {frame.iteration + 1}" if frame.iteration else ""
-        _text(img, f"step {frame.step + 1} (instruction {frame.pc}{loop})", (4, 13), GREY, 0.36)
-        _text(img, _fit(frame.instruction, width, 0.48), (4, 29), RED if frame.failed else INK, 0.48)
+        put_text(img, f"step {frame.step + 1} (instruction {frame.pc}{loop})", (4, 13), GREY, 0.36)
+        put_text(img, fit_text(frame.instruction, width, 0.48), (4, 29), RED if frame.failed else INK, 0.48)
     y = HEADER + size + 15
     if frame.failed:
-        _text(img, _fit(f"FAILED: {m.fail_reason}", width), (4, y), RED)
-        _text(img, "the machine stops here", (4, y + 17), RED, 0.38)
+        put_text(img, fit_text(f"FAILED: {m.fail_reason}", width), (4, y), RED)
+        put_text(img, "the machine stops here", (4, y + 17), RED, 0.38)
     elif not input_frame and m.blackboard.parsed:
         a, b, i = m.attention, m.blackboard, m.hand.held
         shape = "*" if a.shape_filter < 0 else SHAPES[a.shape_filter]
         color = "*" if a.color_filter < 0 else COLORS[a.color_filter]
         listed = "list stale" if a.stale else f"{len(a.attended_list)} listed, at {a.cursor + 1}"
-        _text(img, _fit(f"attend {shape}/{color}: {listed}", width), (4, y), ATTEND, 0.38)
+        put_text(img, fit_text(f"attend {shape}/{color}: {listed}", width), (4, y), ATTEND, 0.38)
         held = "hand empty" if i < 0 else f"holds {COLORS[b.color[i]]} {SHAPES[m.shapes[i]]}"
         kind = b.imagined_kind
         imagined = "" if kind < 0 else ", imagining a " + ("circle" if kind == 0 else "line")
         n = len(m.fovea.history) - 1
         fixations = f"{n} fixation" + ("" if n == 1 else "s")
-        _text(img, _fit(f"{held}, {fixations}{imagined}", width), (4, y + 17), INK, 0.38)
+        put_text(img, fit_text(f"{held}, {fixations}{imagined}", width), (4, y + 17), INK, 0.38)
     if frame.failed:
         cv2.rectangle(img, (0, 0), (img.shape[1] - 1, img.shape[0] - 1), RED, 3)
     return img

@@ -70,3 +70,42 @@ def concept_list(spec: str) -> list[str]:
     if unknown:
         raise ValueError(f"unknown concept(s): {', '.join(unknown)} (see `vcc concepts`)")
     return chosen
+
+
+def read_programs(path) -> dict[str, Program]:
+    """Concepts given as `name: program` lines (`#` starts a comment; blank lines are
+    skipped), for `vcc dataset build --programs`. Each name once, not one of the 546, and
+    each program valid; an error names the file and line."""
+    import re
+    from pathlib import Path
+
+    from vccjax.machine.program import parse
+
+    path = Path(path)
+    try:
+        lines = path.read_text().splitlines()
+    except FileNotFoundError:
+        raise DataFileError(f"{path}: no such programs file") from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise DataFileError(f"{path}: cannot be read as text ({e})") from None
+    shipped = set(concept_names())
+    out: dict[str, Program] = {}
+    for k, raw in enumerate(lines, 1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        name, sep, text = line.partition(":")
+        name = name.strip()
+        if not sep or not re.match(r"^[a-z][a-z0-9_]{0,63}$", name):
+            raise DataFileError(f"{path}:{k}: expected `name: program` with a lower-case name (letters, digits, _)")
+        if name in shipped:
+            raise DataFileError(f"{path}:{k}: {name!r} is one of the 546 shipped concepts; choose another name")
+        if name in out:
+            raise DataFileError(f"{path}:{k}: {name!r} is given twice")
+        try:
+            out[name] = parse(text)
+        except ProgramSyntaxError as e:
+            raise DataFileError(f"{path}:{k}: {e}") from None
+    if not out:
+        raise DataFileError(f"{path}: holds no `name: program` line")
+    return out

@@ -29,6 +29,7 @@ from vccjax.errors import DataFileError, read_json
 from vccjax.world.pairs import TEST, TRAIN, TRAIN_WIDE, WIDE_PATIENCE, ExampleError, discriminate, make_pairs
 from vccjax.machine.instructions import COLORS, SHAPES
 from vccjax.world.rivals import rival_programs
+from vccjax.machine.program import Program, parse
 from vccjax.machine.scene import Scene, SceneObject
 
 FORMAT = "vccjax-dataset"
@@ -113,25 +114,42 @@ def read_npz(path: Path) -> dict[str, np.ndarray]:
 
 
 # ---- building ----------------------------------------------------------------------------
-def _concept_rng(seed: int, index: int, split: int) -> np.random.Generator:
-    return np.random.default_rng([seed, index, split])
+def stream_key(name: str) -> int:
+    """The number a concept's random stream is seeded with, from its name: for one of the
+    546, its place in the benchmark's list (so the shipped examples stay byte for byte
+    what they were); for any other, the first 8 bytes of the name's sha256 (so a
+    concept's examples do not depend on which others are built with it)."""
+    names = concept_names()
+    if name in names:
+        return names.index(name)
+    return int.from_bytes(hashlib.sha256(name.encode()).digest()[:8], "big") | (1 << 63)
 
 
-def build_concept(name: str, index: int, seed: int, cfg: VCCConfig) -> dict[str, np.ndarray]:
-    program = reference_program(name)
+def _concept_rng(seed: int, key: int, split: int) -> np.random.Generator:
+    return np.random.default_rng([seed, key, split])
+
+
+def file_name(name: str) -> str:
+    """A concept's file in a dataset folder: c###.npz for the 546, u-<name>.npz otherwise."""
+    names = concept_names()
+    return f"c{names.index(name):03d}.npz" if name in names else f"u-{name}.npz"
+
+
+def build_concept(name: str, program: Program, seed: int, cfg: VCCConfig) -> dict[str, np.ndarray]:
     arrays: dict[str, np.ndarray] = {
         "format_version": np.array([VERSION], np.int32),
         "concept": _text(name), "program": _text(program.text()),
         "seed": np.array([seed], np.int64), "raster": np.array([cfg.raster], np.int32),
     }
+    key = stream_key(name)
     for split_id, (split, spec) in enumerate((("train", TRAIN), ("test", TEST))):
-        rng = _concept_rng(seed, index, split_id)
+        rng = _concept_rng(seed, key, split_id)
         pairs = make_pairs(program, spec, rng, cfg)
         if split == "train":
             rivals = rival_programs(program)
             programs = [r for _, r in rivals]
             pairs, left = discriminate(program, pairs, programs, spec, rng, cfg)
-            if left:  # a second chance on the test's wider scenes (examples.TRAIN_WIDE)
+            if left:  # a second chance on the test's wider scenes (pairs.TRAIN_WIDE)
                 pairs, left = discriminate(program, pairs, programs, TRAIN_WIDE, rng, cfg, patience=WIDE_PATIENCE)
             arrays["train_rivals_left"] = _text("\n".join(rivals[i][0] for i in left))
         for side, scenes in (("in", [p[0] for p in pairs]), ("out", [p[1] for p in pairs])):
@@ -141,20 +159,20 @@ def build_concept(name: str, index: int, seed: int, cfg: VCCConfig) -> dict[str,
     return arrays
 
 
-def _build_one(job: tuple[str, int, int, VCCConfig, str]) -> tuple[str, str, str | None, list[str]]:
+def _build_one(job: tuple[str, str, int, VCCConfig, str]) -> tuple[str, str, str | None, list[str]]:
     """(concept, sha256 of its file, error or None, rivals its training pairs leave untold)."""
-    name, index, seed, cfg, out = job
-    path = Path(out) / f"c{index:03d}.npz"
-    if path.exists():  # resume: keep a finished file if it is intact and from this seed
+    name, text, seed, cfg, out = job
+    path = Path(out) / file_name(name)
+    if path.exists():  # resume: keep a finished file if it is intact and from this seed and program
         try:
             a = read_npz(path)
             if (int(a["format_version"][0]) == VERSION and int(a["seed"][0]) == seed
-                    and bytes(a["concept"]).decode() == name):
+                    and bytes(a["concept"]).decode() == name and bytes(a["program"]).decode() == text):
                 return name, hashlib.sha256(path.read_bytes()).hexdigest(), None, _lines(a["train_rivals_left"])
         except DataFileError:
             pass
     try:
-        arrays = build_concept(name, index, seed, cfg)
+        arrays = build_concept(name, parse(text), seed, cfg)
     except ExampleError as e:
         return name, "", str(e), []
     return name, write_npz(path, arrays), None, _lines(arrays["train_rivals_left"])
@@ -167,24 +185,36 @@ def _lines(text: np.ndarray) -> list[str]:
 def build_dataset(
     out: str | Path, concepts: Iterable[str] | None = None, seed: int = 0,
     cfg: VCCConfig = DEFAULT_CONFIG, workers: int = 0, progress: bool = True,
+    programs: dict[str, Program] | None = None,
 ) -> dict:
-    """Build (or resume building) the dataset under `out`; returns the manifest."""
+    """Build (or resume building) the dataset under `out`; returns the manifest. The
+    concepts are the 546 (all, or those named), or, with `programs`, the concepts given
+    there by name and program (their examples made from those programs). Every name is
+    checked before anything is written."""
     from vccjax.parallel import map_with_progress
 
     out = Path(out)
+    if programs is None:
+        names = concept_names()
+        wanted = names if concepts is None else list(concepts)
+        unknown = [c for c in wanted if c not in names]
+        if unknown:
+            raise DataFileError(f"unknown concept(s): {', '.join(unknown[:5])}")
+        texts = {n: reference_program(n).text() for n in wanted}
+    else:
+        if concepts is not None:
+            missing = [c for c in concepts if c not in programs]
+            if missing:
+                raise DataFileError(f"not in the programs given: {', '.join(missing[:5])}")
+        texts = {n: programs[n].text() for n in (programs if concepts is None else concepts)}
     out.mkdir(parents=True, exist_ok=True)
-    names = concept_names()
-    wanted = names if concepts is None else list(concepts)
-    unknown = [c for c in wanted if c not in names]
-    if unknown:
-        raise DataFileError(f"unknown concept(s): {', '.join(unknown[:5])}")
-    jobs = [(n, names.index(n), seed, cfg, str(out)) for n in wanted]
+    jobs = [(n, text, seed, cfg, str(out)) for n, text in texts.items()]
     results = map_with_progress(_build_one, jobs, workers, 4, "concepts", progress, unit="concept")
     manifest = {
         "format": FORMAT, "version": VERSION, "seed": seed,
         "config": {"raster": cfg.raster, "n_max": cfg.n_max},
         "splits": {"train": vars_of(TRAIN), "train_wide": vars_of(TRAIN_WIDE), "test": vars_of(TEST)},
-        "concepts": {n: {"file": f"c{names.index(n):03d}.npz", "sha256": h} for n, h, err, _ in results if not err},
+        "concepts": {n: {"file": file_name(n), "sha256": h} for n, h, err, _ in results if not err},
         "failed": {n: err for n, _, err, _ in results if err},
         "rivals_left": {n: left for n, _, err, left in results if left and not err},
     }
@@ -257,6 +287,11 @@ class Dataset:
                 raise DataFileError(f"{path}: holds concept {bytes(arrays['concept']).decode()!r}, not {concept!r}")
             self._cache[concept] = arrays
         return self._cache[concept]
+
+    def program(self, concept: str) -> Program:
+        """The program the concept's examples were made with (its answer: read only by
+        research settings that ask for it, `--args oracle` and fixation guidance)."""
+        return parse(bytes(self.arrays(concept)["program"]).decode())
 
     def sha256(self, concept: str) -> str:
         """The manifest's hash of the concept's file: what identifies its examples."""

@@ -159,9 +159,11 @@ def _draws(program: Program, spec: ExampleSpec, rng: np.random.Generator, cfg: V
     """Endless draws: (input, output) where the program runs and changes the input, else None.
     Draw only as many as are used: the rng goes on to the next step."""
     pointer = uses_pointer(program)
+    on_object = any(NAMES[op] == "attend_pointer" for op in program.ops)  # it points at an object
     while True:
         try:
-            scene = random_scene(rng, spec.objects, widths=spec.widths, pointer=pointer, cfg=cfg)
+            scene = random_scene(rng, spec.objects, widths=spec.widths, pointer=pointer, cfg=cfg,
+                                 pointer_on_object=on_object)
         except SceneError:
             yield None  # too crowded to place
             continue

@@ -73,13 +73,18 @@ def random_scene(
     max_tries: int = 200,
     gap: int = 2,
     pointer_clearance: int = 3,
+    shapes: tuple[str, ...] = SHAPES,
+    colors: tuple[str, ...] = COLORS,
+    pointer_on_object: bool = False,
 ) -> Scene:
     """A valid scene: objects drawn uniformly, placed by rejection.
 
     Generated inputs keep `gap` raster pixels between the pixels objects' drawn shapes
     touch (`drawn_cover`, a superset of their masks), so that drawn shapes never touch,
     as in the paper's figures, and an image parser can tell them apart; the pointer
-    stays `pointer_clearance` pixels away from every object.
+    stays `pointer_clearance` pixels away from every object, unless `pointer_on_object`:
+    then it lies on a pixel of a random object's mask (what `attend_pointer` reads).
+    Shapes and colours are drawn uniformly from `shapes` and `colors` (default: all).
     """
     if isinstance(n_objects, tuple):
         n = int(rng.integers(n_objects[0], n_objects[1] + 1))
@@ -95,7 +100,7 @@ def random_scene(
         for _ in range(max_tries):
             w = float(rng.uniform(*widths))
             x, y = (float(v) for v in rng.uniform(w / 2, 1 - w / 2, size=2))
-            cand = SceneObject(str(rng.choice(SHAPES)), str(rng.choice(COLORS)), x, y, w)
+            cand = SceneObject(str(rng.choice(shapes)), str(rng.choice(colors)), x, y, w)
             if not box_inside(to_units(x, cfg), to_units(y, cfg), to_units(w, cfg), cfg):
                 continue
             rows, cols = object_pixels(cand.shape, w, to_units(x, cfg), to_units(y, cfg), cfg)
@@ -115,6 +120,11 @@ def random_scene(
         else:
             raise SceneError(f"could not place object {len(objs)} in {max_tries} tries")
     ptr = None
+    if pointer and pointer_on_object and objs:
+        o = objs[int(rng.integers(len(objs)))]
+        rows, cols = object_pixels(o.shape, o.width, to_units(o.x, cfg), to_units(o.y, cfg), cfg)
+        k = int(rng.integers(len(rows)))
+        return Scene(tuple(objs), ((cols[k] + 0.5) / r, (rows[k] + 0.5) / r))  # the pixel's centre
     if pointer:
         c = pointer_clearance
         for _ in range(max_tries):

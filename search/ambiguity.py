@@ -1,0 +1,137 @@
+"""Whether a few examples leave a concept ambiguous, and which scene would settle it.
+
+Several programs may explain every given pair. They are run on fresh scenes drawn like
+the user's inputs (the same shapes and colours, as many objects, as wide, a pointer
+when the inputs have one); programs that give the same outcome on every fresh scene
+behave alike and count as one. The examples are ambiguous when a program that behaves
+unlike the first one found gives another output on a fresh scene where the first runs
+(on at least `min_scenes` of them, so a rare tie of distances is not an alarm). The
+question put back is the fresh scene whose outcomes differ the most: the user answers
+it by adding that input with the output they mean as one more pair.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+
+from vccjax.errors import SceneError
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.program import Program
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, scenes_match
+
+
+@dataclasses.dataclass(frozen=True)
+class SceneStyle:
+    """What fresh scenes share with the user's inputs."""
+
+    objects: tuple[int, int]
+    widths: tuple[float, float]
+    shapes: tuple[str, ...]
+    colors: tuple[str, ...]
+    pointer: bool
+    pointer_on_object: bool  # the inputs' pointers lie on objects (as `attend_pointer` needs)
+
+    @classmethod
+    def of(cls, inputs: Sequence[Scene], cfg: VCCConfig = DEFAULT_CONFIG) -> SceneStyle:
+        counts = [len(s.objects) for s in inputs]
+        widths = [o.width for s in inputs for o in s.objects]
+        pointed = [s for s in inputs if s.pointer is not None]
+        return cls((min(counts), max(counts)), (min(widths), max(widths)),
+                   tuple(sorted({o.shape for s in inputs for o in s.objects})),
+                   tuple(sorted({o.color for s in inputs for o in s.objects})),
+                   bool(pointed), bool(pointed) and all(_points_at_an_object(s, cfg) for s in pointed))
+
+
+def _points_at_an_object(scene: Scene, cfg: VCCConfig) -> bool:
+    """Whether an object's mask holds the pointer's pixel (the rule `attend_pointer` reads)."""
+    from vccjax.machine.geometry import object_pixels
+    from vccjax.machine.scene import to_units
+
+    m = RefMachine(scene, cfg, validate=False)
+    pixel = m.pixel_of(m.pointer)
+    for o in scene.objects:
+        rows, cols = object_pixels(o.shape, o.width, to_units(o.x, cfg), to_units(o.y, cfg), cfg)
+        if pixel in set(zip(rows.tolist(), cols.tolist())):
+            return True
+    return False
+
+
+def fresh_scenes(inputs: Sequence[Scene], n: int, seed: int, cfg: VCCConfig = DEFAULT_CONFIG) -> list[Scene]:
+    """`n` seeded random scenes like `inputs` (`SceneStyle`); a draw that cannot be
+    placed is drawn again, and fewer are returned only if most draws fail."""
+    from vccjax.world.scenes import random_scene
+
+    style = SceneStyle.of(inputs, cfg)
+    rng = np.random.default_rng([seed, 0xA1B])
+    scenes: list[Scene] = []
+    for _ in range(4 * n):
+        if len(scenes) == n:
+            break
+        try:
+            scenes.append(random_scene(rng, style.objects, widths=style.widths, pointer=style.pointer, cfg=cfg,
+                                       shapes=style.shapes, colors=style.colors,
+                                       pointer_on_object=style.pointer_on_object))
+        except SceneError:
+            continue
+    return scenes
+
+
+def outcomes(program: Program, scenes: Sequence[Scene], cfg: VCCConfig = DEFAULT_CONFIG) -> list[Scene | None]:
+    """The program's output on each scene (None where it fails), on the reference."""
+    out = []
+    for s in scenes:
+        m = RefMachine(s, cfg, validate=False).run(program)
+        out.append(None if m.failed else m.output_scene())
+    return out
+
+
+def same(a: Scene | None, b: Scene | None, tau: float) -> bool:
+    return (a is None and b is None) or (a is not None and b is not None and scenes_match(a, b, tau))
+
+
+@dataclasses.dataclass
+class Verdict:
+    """The programs that behave differently (the first found first), how many fresh
+    scenes each parts from the first on, and the question to ask."""
+
+    programs: list[int]  # indices into the candidates: one per distinct behaviour
+    disagree: list[int]  # per kept program: fresh scenes where the first runs and it differs
+    scenes: int  # fresh scenes drawn
+    ambiguous: bool
+    query: int | None  # index of the fresh scene to ask about
+    query_outputs: list[Scene | None]  # each kept program's outcome on it
+
+
+def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int = 100, seed: int = 0,
+          min_scenes: int = 2, cfg: VCCConfig = DEFAULT_CONFIG) -> tuple[Verdict, list[Scene]]:
+    """Group `candidates` (the first is the program learned) by behaviour on fresh
+    scenes like `inputs`, decide whether the examples are ambiguous, and pick the query."""
+    scenes = fresh_scenes(inputs, n_scenes, seed, cfg)
+    tau = cfg.tau
+    runs = [outcomes(p, scenes, cfg) for p in candidates]
+    kept: list[int] = []
+    for i, run in enumerate(runs):
+        if not any(all(same(x, y, tau) for x, y in zip(run, runs[k], strict=True)) for k in kept):
+            kept.append(i)
+    first = runs[0]
+    disagree = [sum(1 for j, o in enumerate(first) if o is not None and not same(o, runs[k][j], tau)) for k in kept]
+    ambiguous = any(d >= min_scenes for d in disagree[1:])
+    query = None
+    if ambiguous:
+        def telling(j: int) -> tuple:
+            outs = [runs[k][j] for k in kept]
+            groups: list[Scene | None] = []
+            for o in outs:
+                if not any(same(o, g, tau) for g in groups):
+                    groups.append(o)
+            runs_ok = sum(o is not None for o in outs)
+            return (len(groups), runs_ok, -len(scenes[j].objects), -j)
+
+        usable = [j for j in range(len(scenes)) if first[j] is not None]
+        query = max(usable, key=telling)
+    outs = [runs[k][query] for k in kept] if query is not None else []
+    return Verdict(kept, disagree, len(scenes), ambiguous, query, outs), scenes

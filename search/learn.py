@@ -1,0 +1,147 @@
+"""Learn one new concept from a user's example pairs: the search of explore-compress,
+started from the learned library, and a question back when the examples are ambiguous.
+
+Nothing here reads an answer: arguments come from the argument CNN on the pairs (or
+uniform), fixation from the user's hint when given. The search finds the most probable
+program under the library's model that explains every pair (as `vcc induce` would), and
+keeps searching, within a bounded extra budget, for other programs that explain them too
+(`search.dfs.Alternatives`); `search.ambiguity` then tells whether those behave
+differently on fresh scenes and which scene to ask about.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+
+from search.ambiguity import Verdict, judge
+from search.arguments import argument_logp
+from search.chain import Chain
+from search.dfs import Alternatives
+from search.explore import Searcher
+from search.model import MarkovModel, Vocabulary
+from search.result import Result
+from search.task import Task
+from vccjax.machine.config import DEFAULT_CONFIG
+from vccjax.machine.program import Program
+from vccjax.machine.scene import Scene
+
+LIBRARIES = ("shipped", "uniform")  # or a library file's path
+
+
+@dataclasses.dataclass(frozen=True)
+class LearnSettings:
+    budget: int = 500_000  # programs searched for the first fit, at most
+    args: str = "predicted"  # or "uniform"
+    fixate: tuple[str, ...] | None = None  # the teacher's hint: fixate only to these
+    library: str = "shipped"  # "shipped", "uniform" (from scratch) or a library file
+    rival_margin_nats: float = 6.0  # rivals at most this much less probable than the first
+    rival_budget: int = 100_000  # programs judged after the first fit, at most, to find rivals
+    max_rivals: int = 32
+    fresh_scenes: int = 100
+    min_scenes: int = 2  # fresh scenes a rival must part on to make the examples ambiguous
+    seed: int = 0
+    delta: float = 0.01
+
+    def __post_init__(self) -> None:
+        if self.args not in ("predicted", "uniform"):
+            raise ValueError(f"--args must be predicted or uniform, got {self.args!r}")
+        if self.budget < 1:
+            raise ValueError(f"--budget must be positive, got {self.budget}")
+        if self.rival_budget < 0 or self.max_rivals < 1 or self.rival_margin_nats < 0:
+            raise ValueError("the rival search's budget, margin and count must not be negative")
+        if self.fresh_scenes < 1:
+            raise ValueError(f"--fresh-scenes must be positive, got {self.fresh_scenes}")
+
+
+@dataclasses.dataclass
+class Learned:
+    """What learning reported: the program, the rivals, and the question when ambiguous."""
+
+    result: Result
+    library: str  # the library's content sha256, or "uniform"
+    verdict: Verdict | None  # None when nothing fits
+    scenes: list[Scene]  # the fresh scenes the verdict ran on
+
+    @property
+    def found(self) -> bool:
+        return self.result.found
+
+    @property
+    def program(self) -> Program | None:
+        return self.result.program
+
+    @property
+    def ambiguous(self) -> bool:
+        return bool(self.verdict and self.verdict.ambiguous)
+
+    def rivals(self) -> list[tuple[Program, str, float, int]]:
+        """(program, as searched, description length in nats, fresh scenes it parts from
+        the first on) of each program that behaves unlike the first."""
+        if self.verdict is None:
+            return []
+        cands = self.candidates()
+        return [(cands[i][0], cands[i][1], cands[i][2], d)
+                for i, d in zip(self.verdict.programs[1:], self.verdict.disagree[1:], strict=True)]
+
+    def candidates(self) -> list[tuple[Program, str, float]]:
+        r = self.result
+        if not r.found:
+            return []
+        return [(r.program, r.text, r.dl_nats)] + [(a.program, a.text, a.dl_nats) for a in r.alternatives]
+
+    @property
+    def query_scene(self) -> Scene | None:
+        if self.verdict is None or self.verdict.query is None:
+            return None
+        return self.scenes[self.verdict.query]
+
+
+def model_for(library: str) -> tuple[Vocabulary, MarkovModel, str]:
+    """(vocabulary, model, name) to start from: the shipped library, a library file, or
+    a uniform model over the atoms (from scratch)."""
+    if library == "uniform":
+        return Vocabulary(), MarkovModel.uniform(Vocabulary().size, 1), "uniform"
+    from search.library import load
+
+    lib = load(None if library == "shipped" else library)
+    return lib.vocab, lib.model, lib.sha256
+
+
+def chain_for(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings,
+              start: tuple[Vocabulary, MarkovModel, str] | None = None) -> tuple[Chain, str]:
+    """The search's chain for these pairs: the start model and the argument beliefs."""
+    vocab, model, name = start or model_for(settings.library)
+    mode = settings.args + ("+fixation" if settings.fixate else "")
+    return Chain(vocab, model, argument_logp(mode, pairs, None, settings.fixate), settings.delta), name
+
+
+def alternatives_for(chain: Chain, settings: LearnSettings) -> Alternatives:
+    margin = int(math.ceil(settings.rival_margin_nats / chain.delta))
+    return Alternatives(margin, settings.max_rivals, settings.rival_budget)
+
+
+def verdict_for(result: Result, pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings
+                ) -> tuple[Verdict | None, list[Scene]]:
+    if not result.found:
+        return None, []
+    programs = [result.program] + [a.program for a in result.alternatives]
+    return judge(programs, [a for a, _ in pairs], settings.fresh_scenes, settings.seed, settings.min_scenes,
+                 DEFAULT_CONFIG)
+
+
+def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searcher: Searcher | None = None,
+          progress: Callable[[int], None] | None = None) -> Learned:
+    """Learn a program for `pairs` (at least one), and judge the rivals found beside it."""
+    if not pairs:
+        raise ValueError("learning needs at least one example pair")
+    chain, name = chain_for(pairs, settings)
+    if searcher is None:
+        from search.explore import Explorer
+
+        searcher = Explorer(width=1)
+    result = searcher.search(chain, Task.from_pairs(pairs), settings.budget, progress,
+                             alternatives_for(chain, settings))
+    verdict, scenes = verdict_for(result, pairs, settings)
+    return Learned(result, name, verdict, scenes)

@@ -1,0 +1,229 @@
+"""`vcc learn` (a new concept from the user's example pairs) and `vcc library` (the
+learned library: build it from a finished `vcc induce` run, or show the shipped one).
+
+`vcc learn` reads and checks every pair before it searches, and writes its files only
+once learning is over, each whole (a temporary file replaced): an interrupted or failed
+run leaves the output folder as it was.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+
+from vccjax import runtime
+from vccjax.errors import VCCError
+
+QUERY_FILES = ("query.json", "query.png", "query_in.json")
+
+
+def _settings(a: argparse.Namespace):
+    from search.learn import LearnSettings
+
+    fixate = None
+    if a.fixate is not None:
+        fixate = tuple(v.strip() for v in a.fixate.split(",") if v.strip())
+        from vccjax.machine.instructions import FIXATE_TARGETS
+
+        bad = [v for v in fixate if v not in FIXATE_TARGETS] or ([] if fixate else [a.fixate])
+        if bad:
+            raise VCCError(f"--fixate {a.fixate}: each value must be one of {', '.join(FIXATE_TARGETS)}")
+    return LearnSettings(budget=a.budget, args=a.args, fixate=fixate, library=a.library,
+                         rival_budget=a.rival_budget, fresh_scenes=a.fresh_scenes, seed=a.seed)
+
+
+def _letter(k: int) -> str:
+    return chr(ord("A") + k) if k < 26 else f"R{k}"
+
+
+def concept_record(learned, examples: list[tuple[str, object, object]], files: list[str], settings) -> dict:
+    """What `DIR/concept.json` holds: the program (subroutines expanded, runnable by
+    `vcc run`), how it was found, the rivals, and the examples it was learned from."""
+    r = learned.result
+    rivals = [{"label": _letter(k + 1), "program": p.text(), "as_searched": text, "description_length": round(dl, 4),
+               "differs_on_fresh_scenes": d}
+              for k, (p, text, dl, d) in enumerate(learned.rivals())]
+    return {
+        "program": r.program.text(), "as_searched": r.text, "description_length": round(r.dl_nats, 4),
+        "pairs_right": len(examples), "pairs": len(examples), "ambiguous": learned.ambiguous,
+        "rivals": rivals, "fresh_scenes": learned.verdict.scenes if learned.verdict else 0,
+        "library": learned.library, "examples": files,
+        "search": {"rank": r.rank, "programs_judged": r.programs, "seconds": round(r.seconds, 3),
+                   "compile_seconds": round(r.compile_seconds, 3), "budget": r.budget},
+        "settings": {"budget": settings.budget, "args": settings.args, "fixate": settings.fixate,
+                     "library": settings.library, "rival_budget": settings.rival_budget, "seed": settings.seed},
+    }
+
+
+def _write_json(folder: Path, name: str, content) -> None:
+    (folder / name).write_text(json.dumps(content, indent=1) + "\n")
+
+
+def cmd_learn(a: argparse.Namespace) -> int:
+    from search.learn import learn
+    from vccjax.vision.examples_folder import pair_files, read_pairs
+    from vccjax.world.user_concepts import check_name, save_concept
+
+    settings = _settings(a)
+    if a.save and not a.name:
+        raise VCCError("--save needs --name NAME (the name to run the concept by)")
+    if a.name:
+        check_name(a.name)
+    examples = read_pairs(a.examples)  # every pair read and checked before any search
+    files = [f"{p.name}:{hashlib.sha256(p.read_bytes()).hexdigest()[:16]}"
+             for _, fin, fout in pair_files(a.examples) for p in (fin, fout)]
+    pairs = [(i, o) for _, i, o in examples]
+    runtime.prepare()
+    from tqdm import tqdm
+
+    print(f"{len(pairs)} pairs from {a.examples}; library: {settings.library}; arguments: {settings.args}"
+          + (f"; fixate: {','.join(settings.fixate)}" if settings.fixate else ""))
+    bar = tqdm(unit=" prefixes", unit_scale=True, disable=a.quiet, desc="searching")
+    searcher = None
+    if a.engine == "reference":
+        from search.scalar import ScalarExplorer
+
+        searcher = ScalarExplorer(width=1)
+    learned = learn(pairs, settings, searcher, progress=lambda n: bar.update(n))
+    bar.close()
+    r = learned.result
+    if not r.found:
+        print(f"searched {r.programs:,} programs in {r.seconds:.1f} s")
+        raise VCCError(f"no program under the budget ({settings.budget:,}) explains every pair; try a larger "
+                       "--budget, more pairs, or --fixate to point out where to look")
+    record = concept_record(learned, examples, files, settings)
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=out, prefix=".learn-") as tmp:
+        tmp = Path(tmp)
+        written = _write_results(tmp, learned, record, pairs[0][0])
+        old = ["concept.json", "trace.png", *QUERY_FILES, *(p.name for p in out.glob("query_out_*.json"))]
+        for name in old:  # the old question goes with the old answer
+            if name not in written and (out / name).exists():
+                (out / name).unlink()
+        for name in written:
+            os.replace(tmp / name, out / name)
+    _report(learned, record, out)
+    if a.save:
+        path = save_concept(a.name, record)
+        print(f"saved as {a.name!r} in {path.parent} (vcc run --concept {a.name})")
+    return 0
+
+
+def _write_results(folder: Path, learned, record: dict, first_input) -> list[str]:
+    from vccjax.views.query import write_query
+    from vccjax.views.trace import trace
+    from vccjax.views.viewer import write_trace
+
+    write_trace(trace(learned.program, first_input), folder / "trace.png")
+    names = ["trace.png"]
+    if learned.ambiguous:
+        v, scene = learned.verdict, learned.query_scene
+        cands = learned.candidates()
+        outputs = [(_letter(k), cands[i][0].text(), o) for k, (i, o) in enumerate(zip(v.programs, v.query_outputs))]
+        _write_json(folder, "query.json", {
+            "question": "which output do you mean for this input? Add the input and that output as one more pair "
+                        "(copy query_in.json as <k>_in.json and the chosen output as <k>_out.json into your "
+                        "examples folder), then run vcc learn again",
+            "input": scene.to_dict(),
+            "answers": [{"label": lab, "program": text, "output": None if o is None else o.to_dict()}
+                        for lab, text, o in outputs]})
+        _write_json(folder, "query_in.json", scene.to_dict())
+        write_query(folder / "query.png", scene, outputs)
+        names += list(QUERY_FILES)
+        for lab, _, o in outputs:
+            if o is not None:
+                _write_json(folder, f"query_out_{lab}.json", o.to_dict())
+                names.append(f"query_out_{lab}.json")
+        record["query"] = {"files": names[1:], "answers": len(outputs)}
+    _write_json(folder, "concept.json", record)
+    return ["concept.json", *names]
+
+
+def _report(learned, record: dict, out: Path) -> None:
+    r = learned.result
+    print(f"learned ({len(r.program)} instructions, {r.dl_nats:.2f} nats, rank {r.rank:,}; "
+          f"{r.programs:,} programs judged in {r.seconds:.1f} s, {r.compile_seconds:.1f} s of it compiling):")
+    print(f"  {r.program.text()}")
+    if r.text != r.program.text():
+        print(f"  as searched: {r.text}")
+    print(f"explains {record['pairs_right']} of {record['pairs']} pairs")
+    if learned.ambiguous:
+        print(f"AMBIGUOUS: {len(record['rivals'])} other program(s) explain every pair but act otherwise on new scenes:")
+        for rv in record["rivals"]:
+            print(f"  {rv['label']}: {rv['program']}  (differs on {rv['differs_on_fresh_scenes']} of "
+                  f"{record['fresh_scenes']} fresh scenes)")
+        print(f"question: {out / 'query.png'} (and query.json): add its input with the output you mean as a pair, "
+              "and learn again")
+    else:
+        print(f"not ambiguous: the programs found beside it act alike on {record['fresh_scenes']} fresh scenes")
+    print(f"wrote {out / 'concept.json'} and {out / 'trace.png'}")
+
+
+def cmd_library_build(a: argparse.Namespace) -> int:
+    from search.library import build, save
+
+    content = build(a.source)
+    sha = save(content, a.out)
+    print(f"{len(content['card']['concepts'])} programs of {a.source}, {len(content['subroutines'])} subroutines "
+          f"-> {a.out} (sha256 {sha[:12]}...)")
+    return 0
+
+
+def cmd_library_show(a: argparse.Namespace) -> int:
+    from search.library import load, shipped_library
+
+    lib = load(a.path)
+    print(f"{a.path or shipped_library()}: sha256 {lib.sha256}")
+    card = lib.card
+    print(f"  from run {card['source_run']} ({card['settings'].get('args')} arguments, budget "
+          f"{card['settings'].get('budget'):,}): {len(card['concepts'])} programs")
+    print(f"  {len(lib.vocab.bodies)} subroutines, order {lib.model.order}, epsilon {lib.model.epsilon}")
+    for name, sub in list(lib.vocab.subroutines().items())[: a.show]:
+        print(f"  {name}: {'; '.join(sub.body)}")
+    return 0
+
+
+def add_commands(sub) -> None:
+    p = sub.add_parser(
+        "learn", help="learn a new concept from your own before/after pairs (JSON scenes or pictures)",
+        description="Learn a program from EXAMPLES, a folder of pairs <k>_in.json/<k>_out.json (scenes) or "
+                    "<k>_in.png/<k>_out.png (pictures), starting from the library learned on the 546 concepts. "
+                    "Writes OUT/concept.json and OUT/trace.png; when the pairs leave the concept ambiguous, also "
+                    "OUT/query.png and OUT/query.json, a new input to answer with one more pair.")
+    p.add_argument("examples", metavar="EXAMPLES", help="folder of example pairs")
+    p.add_argument("--out", required=True, help="folder for concept.json, trace.png and the query")
+    p.add_argument("--budget", type=int, default=500_000, help="programs searched at most (default 500000)")
+    p.add_argument("--library", default="shipped",
+                   help="'shipped' (default: learned on the 546), 'uniform' (from scratch) or a library file")
+    p.add_argument("--args", choices=["predicted", "uniform"], default="predicted",
+                   help="arguments: predicted by the CNN from the pairs (default) or uniform")
+    p.add_argument("--fixate", help="the teacher's hint: where to look first (left, right, top, bottom, center; "
+                                    "several comma-separated)")
+    p.add_argument("--rival-budget", type=int, default=100_000,
+                   help="programs searched after the first fit, looking for rivals (default 100000; 0: none)")
+    p.add_argument("--fresh-scenes", type=int, default=100, help="scenes the rivals are compared on (default 100)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the fresh scenes (default 0)")
+    p.add_argument("--name", help="a name for the concept (with --save)")
+    p.add_argument("--save", action="store_true",
+                   help="add it to your concept library ($VCC_LIBRARY, default ~/.local/share/vccjax/concepts)")
+    p.add_argument("--engine", choices=["jax", "reference"], default="jax",
+                   help="search on the batched JAX emulator (default) or on the reference interpreter (no "
+                        "compiling: quicker for small budgets)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(fn=cmd_learn)
+
+    lib = sub.add_parser("library", help="the learned library: what explore-compress learned on the 546")
+    lsub = lib.add_subparsers(dest="action", required=True)
+    b = lsub.add_parser("build", help="rebuild it from a finished `vcc induce` run folder")
+    b.add_argument("--from", dest="source", required=True, help="the run folder (run.json, results.jsonl)")
+    b.add_argument("--out", required=True, help="library file to write (the shipped one: search/data/library.json)")
+    b.set_defaults(fn=cmd_library_build)
+    s = lsub.add_parser("show", help="verify a library and summarise it")
+    s.add_argument("path", nargs="?", help="library file (default: the shipped one)")
+    s.add_argument("--show", type=int, default=10, help="subroutines to list (default 10)")
+    s.set_defaults(fn=cmd_library_show)

@@ -1,0 +1,186 @@
+"""`vcc learn`: a concept from a folder of the user's pairs (scenes or pictures), a
+question back when two pairs leave it ambiguous, the answer settling it, a learned
+concept saved and run by name, and every kind of bad input refused with one line and
+nothing written."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import cv2
+import numpy as np
+import pytest
+
+from search.learn import LearnSettings, learn
+from search.library import shipped_library
+from search.scalar import ScalarExplorer
+from vcc.cli import main
+from vccjax.machine.config import DEFAULT_CONFIG
+from vccjax.machine.program import parse
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, SceneObject, scenes_match
+from vccjax.vision.examples_folder import read_pairs
+from vccjax.vision.render import render
+from vccjax.world.concepts import reference_program
+from vccjax.world.dataset import dataset_for
+
+CONCEPT = "remove_bottom_obj"  # its first two training pairs: the bottom object is also the right-most
+TAU = DEFAULT_CONFIG.tau
+QUICK = ["--engine", "reference", "--budget", "20000", "--quiet"]
+
+
+@pytest.fixture(scope="module")
+def data():
+    return dataset_for([CONCEPT], 0, None, progress=False)
+
+
+def _png(path, scene: Scene) -> None:
+    cv2.imwrite(str(path), cv2.cvtColor(render(scene, 384), cv2.COLOR_RGB2BGR))
+
+
+def _folder(path, pairs, keys=None, png=()):
+    path.mkdir(parents=True, exist_ok=True)
+    for k, (a, b) in zip(keys or range(len(pairs)), pairs, strict=True):
+        for side, s in (("in", a), ("out", b)):
+            if k in png:
+                _png(path / f"{k}_{side}.png", s)
+            else:
+                s.save(path / f"{k}_{side}.json")
+    return path
+
+
+def _explains(program, pairs) -> bool:
+    for a, b in pairs:
+        m = RefMachine(a).run(program)
+        if m.failed or not scenes_match(m.output_scene(), b, TAU):
+            return False
+    return True
+
+
+def test_pairs_are_read_from_scenes_pictures_or_both_in_natural_order(data, tmp_path):
+    pairs = data.pairs(CONCEPT, "train")[:3]
+    for png in ((), (2, 10, 1), (10,)):
+        folder = _folder(tmp_path / f"f{len(png)}", pairs, keys=[2, 10, 1], png=png)
+        got = read_pairs(folder)
+        assert [k for k, _, _ in got] == ["1", "2", "10"]  # 2 before 10
+        for (_, a, b), (x, y) in zip(got, [pairs[2], pairs[0], pairs[1]], strict=True):
+            assert scenes_match(a, x, TAU) and scenes_match(b, y, TAU)
+
+
+def test_two_ambiguous_pairs_get_a_question_and_the_answer_settles_it(data):
+    truth = reference_program(CONCEPT)
+    two = data.pairs(CONCEPT, "train")[:2]
+    settings = LearnSettings(budget=20_000)
+    first = learn(two, settings, ScalarExplorer(width=1))
+    assert first.found and _explains(first.program, two) and first.ambiguous
+    rivals = first.rivals()
+    assert rivals and all(_explains(p, two) for p, _, _, _ in rivals)
+    # the query: an input on which the rivals' outputs differ (checked on the reference)
+    q = first.query_scene
+    outs = [RefMachine(q).run(first.candidates()[i][0]) for i in first.verdict.programs]
+    done = [m.output_scene() for m in outs if not m.failed]
+    assert len(done) >= 2 and any(not scenes_match(done[0], o, TAU) for o in done[1:])
+    # answered with what the concept does there, the three pairs settle it
+    answer = RefMachine(q).run(truth)
+    assert not answer.failed
+    settled = learn([*two, (q, answer.output_scene())], settings, ScalarExplorer(width=1))
+    assert settled.found and not settled.ambiguous
+    assert _explains(settled.program, data.pairs(CONCEPT, "test"))
+
+
+def test_learn_writes_the_concept_saves_it_and_runs_it_by_name(data, tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("VCC_LIBRARY", str(tmp_path / "lib"))
+    pairs = data.pairs(CONCEPT, "train")[:3]
+    folder = _folder(tmp_path / "ex", pairs, png=(2,))  # two scene files, one pair of pictures
+    out = tmp_path / "out"
+    assert main(["learn", str(folder), "--out", str(out), "--name", "drop_lowest", "--save", "--budget", "20000",
+                 "--quiet"]) == 0  # the JAX engine, as users run it
+    c = json.loads((out / "concept.json").read_text())
+    program = parse(c["program"])
+    assert _explains(program, pairs) and c["pairs_right"] == c["pairs"] == 3
+    assert c["ambiguous"] is False and (out / "trace.png").stat().st_size > 0
+    assert not (out / "query.json").exists()
+    assert c["library"] == json.loads(shipped_library().read_text())["content_sha256"]
+    capsys.readouterr()
+    assert main(["run", "--concept", "drop_lowest", "--scene", str(folder / "0_in.json")]) == 0
+    assert "changed" in capsys.readouterr().out
+    assert main(["trace", "--concept", "drop_lowest", "--scene", str(folder / "1_in.json"),
+                 "--out", str(tmp_path / "t.png")]) == 0
+    saved = tmp_path / "lib" / "drop_lowest.json"
+    saved.write_text(saved.read_text().replace("remove_from_imagine_buffer", "fill_color(red)"))
+    assert main(["run", "--concept", "drop_lowest", "--scene", str(folder / "0_in.json")]) == 2
+    assert "content sha256 mismatch" in capsys.readouterr().err
+
+
+def test_a_rerun_with_the_answer_replaces_the_question(data, tmp_path):
+    two = data.pairs(CONCEPT, "train")[:2]
+    folder, out = _folder(tmp_path / "ex", two), tmp_path / "out"
+    assert main(["learn", str(folder), "--out", str(out), *QUICK]) == 0
+    q = json.loads((out / "query.json").read_text())
+    assert len(q["answers"]) >= 2 and (out / "query.png").exists() and (out / "query_in.json").exists()
+    scene = Scene.load(out / "query_in.json")
+    (folder / "q_in.json").write_text((out / "query_in.json").read_text())
+    RefMachine(scene).run(reference_program(CONCEPT)).output_scene().save(folder / "q_out.json")
+    assert main(["learn", str(folder), "--out", str(out), *QUICK]) == 0
+    assert json.loads((out / "concept.json").read_text())["ambiguous"] is False
+    assert not [p.name for p in out.glob("query*")]
+
+
+def _blank(path, color=None) -> None:
+    img = np.full((256, 256, 3), 255, np.uint8)
+    if color is not None:
+        cv2.rectangle(img, (100, 100), (140, 140), color, -1)
+    cv2.imwrite(str(path), img)
+
+
+def _bad_cases(tmp_path, pairs):
+    a, b = pairs[0]
+    extra = Scene(a.objects + (SceneObject("star", "red", 0.9, 0.1, 0.08),), a.pointer)  # one more than the input
+    reshaped = Scene(tuple(SceneObject("circle" if o.shape != "circle" else "square", o.color, o.x, o.y, o.width)
+                           for o in a.objects[:1]), None)
+    return {
+        "empty": (lambda d: d.mkdir(), "holds no example pairs"),
+        "no such folder": (lambda d: None, "no such examples folder"),
+        "half a pair": (lambda d: (_folder(d, [pairs[0]]), os.remove(d / "0_out.json")), "has no out file"),
+        "two inputs": (lambda d: (_folder(d, [pairs[0]]), _png(d / "0_in.png", a)), "already has an in file"),
+        "stray file": (lambda d: (_folder(d, [pairs[0]]), (d / "notes.txt").write_text("x")), "not half of a pair"),
+        "bad json": (lambda d: (_folder(d, [pairs[0]]), (d / "0_in.json").write_text("{")), "0_in.json: not"),
+        "bad png": (lambda d: (_folder(d, [pairs[0]]), os.remove(d / "0_in.json"),
+                               (d / "0_in.png").write_bytes(b"not a png")), "not an image OpenCV can read"),
+        "no objects": (lambda d: (_folder(d, [pairs[0]]), os.remove(d / "0_in.json"), _blank(d / "0_in.png")),
+                       "no objects found"),
+        "unknown colour": (lambda d: (_folder(d, [pairs[0]]), os.remove(d / "0_in.json"),
+                                      _blank(d / "0_in.png", (200, 0, 200))), "unknown color"),
+        "object from nowhere": (lambda d: _folder(d, [(a, extra)]), "never makes one"),
+        "shape changed": (lambda d: _folder(d, [(a, reshaped)]), "has no"),
+    }
+
+
+@pytest.mark.parametrize("case", ["empty", "no such folder", "half a pair", "two inputs", "stray file", "bad json",
+                                  "bad png", "no objects", "unknown colour", "object from nowhere", "shape changed"])
+def test_bad_examples_are_refused_in_one_line_and_nothing_is_written(data, tmp_path, capsys, case):
+    make, message = _bad_cases(tmp_path, data.pairs(CONCEPT, "train"))[case]
+    folder, out = tmp_path / "ex", tmp_path / "out"
+    make(folder)
+    assert main(["learn", str(folder), "--out", str(out), *QUICK]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1, err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--fixate", "up"], "--fixate up"),
+    (["--save"], "--save needs --name"),
+    (["--name", "Bad Name", "--save"], "--name 'Bad Name'"),
+    (["--name", CONCEPT, "--save"], "a shipped concept has this name"),
+    (["--budget", "0"], "--budget must be positive"),
+    (["--library", "no/such/library.json"], "no/such/library.json: missing"),
+    (["--budget", "3"], "no program under the budget"),
+])
+def test_bad_options_and_nothing_found_exit_non_zero(data, tmp_path, capsys, flags, message):
+    folder, out = _folder(tmp_path / "ex", data.pairs(CONCEPT, "train")[:2]), tmp_path / "out"
+    assert main(["learn", str(folder), "--out", str(out), "--engine", "reference", "--quiet", *flags]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1, err
+    assert not out.exists()
