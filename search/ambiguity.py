@@ -93,6 +93,20 @@ def same(a: Scene | None, b: Scene | None, tau: float) -> bool:
     return (a is None and b is None) or (a is not None and b is not None and scenes_match(a, b, tau))
 
 
+def groups_of(outputs: Sequence[Scene | None], tau: float) -> list[list[int]]:
+    """Indices of `outputs` grouped by outcome (one group per distinct output, failing
+    included), in order of first appearance."""
+    groups: list[list[int]] = []
+    for i, o in enumerate(outputs):
+        for g in groups:
+            if same(o, outputs[g[0]], tau):
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    return groups
+
+
 @dataclasses.dataclass
 class Verdict:
     """The programs that behave differently (the first found first), how many fresh
@@ -104,12 +118,18 @@ class Verdict:
     ambiguous: bool
     query: int | None  # index of the fresh scene to ask about
     query_outputs: list[Scene | None]  # each kept program's outcome on it
+    answers: list[list[int]]  # positions in `programs` grouped by their outcome on the query
 
 
 def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int = 100, seed: int = 0,
-          min_scenes: int = 2, cfg: VCCConfig = DEFAULT_CONFIG) -> tuple[Verdict, list[Scene]]:
-    """Group `candidates` (the first is the program learned) by behaviour on fresh
-    scenes like `inputs`, decide whether the examples are ambiguous, and pick the query."""
+          min_scenes: int = 2, cfg: VCCConfig = DEFAULT_CONFIG,
+          nats: Sequence[float] | None = None) -> tuple[Verdict, list[Scene]]:
+    """Group `candidates` (the first is the program learned; `nats`, their description
+    lengths) by behaviour on fresh scenes like `inputs`, decide whether the examples are
+    ambiguous, and pick the query: the fresh scene (one the first program runs on) whose
+    answer is expected to leave the least probability on wrong candidates, that is with
+    the smallest sum over its outcome groups of the group's squared probability (each
+    behaviour weighted by exp(-description length)); ties go to fewer objects."""
     scenes = fresh_scenes(inputs, n_scenes, seed, cfg)
     tau = cfg.tau
     runs = [outcomes(p, scenes, cfg) for p in candidates]
@@ -120,18 +140,16 @@ def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int 
     first = runs[0]
     disagree = [sum(1 for j, o in enumerate(first) if o is not None and not same(o, runs[k][j], tau)) for k in kept]
     ambiguous = any(d >= min_scenes for d in disagree[1:])
+    dl = np.array([nats[k] if nats is not None else 0.0 for k in kept])
+    weight = np.exp(-(dl - dl.min()))
+    weight = weight / weight.sum()
     query = None
     if ambiguous:
-        def telling(j: int) -> tuple:
-            outs = [runs[k][j] for k in kept]
-            groups: list[Scene | None] = []
-            for o in outs:
-                if not any(same(o, g, tau) for g in groups):
-                    groups.append(o)
-            runs_ok = sum(o is not None for o in outs)
-            return (len(groups), runs_ok, -len(scenes[j].objects), -j)
+        def left_after(j: int) -> tuple:
+            groups = groups_of([runs[k][j] for k in kept], tau)
+            return (sum(weight[g].sum() ** 2 for g in groups), len(scenes[j].objects), j)
 
         usable = [j for j in range(len(scenes)) if first[j] is not None]
-        query = max(usable, key=telling)
+        query = min(usable, key=left_after)
     outs = [runs[k][query] for k in kept] if query is not None else []
-    return Verdict(kept, disagree, len(scenes), ambiguous, query, outs), scenes
+    return Verdict(kept, disagree, len(scenes), ambiguous, query, outs, groups_of(outs, tau) if outs else []), scenes

@@ -43,7 +43,7 @@ def used_values(program: Program, name: str) -> list[int]:
 
 
 def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None, answer: Program | None = None,
-                  fixate: Sequence[str] | None = None) -> dict[int, np.ndarray]:
+                  fixate: Sequence[str] | None = None, fallback: bool = False) -> dict[int, np.ndarray]:
     """log p(argument | instruction) under `mode` (see the module's docstring). `answer`
     is needed by oracle and, without `fixate`, by +fixation; `pairs` by predicted."""
     if mode not in MODES:
@@ -58,7 +58,11 @@ def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
 
         if not pairs:
             raise ValueError("--args predicted needs the concept's training pairs")
-        for name, lp in predicted(default_predictor().for_pairs(pairs)).items():
+        probs = default_predictor().for_pairs(pairs)
+        for name, lp in predicted(probs).items():
+            if fallback and not np.isfinite(lp).any():
+                p = np.asarray(probs[name], np.float64)
+                lp = np.log(p / p.sum())
             out[OP[name]] = lp
     if mode.endswith("+fixation"):
         if fixate is not None:

@@ -11,22 +11,33 @@ from vccjax.world.concepts import concept_list
 
 
 def cmd_induce(a: argparse.Namespace) -> int:
-    from search.induce import Settings, induce, summary
+    from search.induce import Settings, induce, needs_answer, summary
     from vccjax.world.dataset import dataset_for
 
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations)
-    names = concept_list(a.concepts)
+    if a.dataset:  # any built dataset: the concepts its manifest holds, their stored programs as answers
+        from vccjax.world.dataset import Dataset
+
+        ds = Dataset(a.dataset)
+        names = concept_list(a.concepts, ds.concepts)
+    else:
+        names = concept_list(a.concepts)
+    start = start_model(a.model, settings) if a.model else None
     if settings.args.startswith("predicted"):
         from argpred.predict import default_predictor
 
         default_predictor()  # a missing or corrupt weights file fails now, with its message
+    if a.dataset and needs_answer(settings):
+        for c in names:  # refuse now, not after an hour, a concept without a stored answer
+            ds.program(c)
     runtime.prepare()
-    ds = dataset_for(names, a.seed, a.dataset, progress=not a.quiet)
+    if not a.dataset:
+        ds = dataset_for(names, a.seed, a.dataset, progress=not a.quiet)
     from search.explore import Explorer
 
     run = induce(names, ds.pairs, a.out, settings, explorer=Explorer(width=a.width), progress=not a.quiet,
-                 examples_sha256=ds.sha256)
+                 examples_sha256=ds.sha256, answers=ds.program, start=start)
     s = summary(run, names)
     (Path(a.out) / "summary.json").write_text(json.dumps(s, indent=1))
     print(f"{'concepts':<28}{s['concepts']}")
@@ -43,6 +54,39 @@ def cmd_induce(a: argparse.Namespace) -> int:
     return 0
 
 
+def start_model(spec: str, settings):
+    """The model `--model` names: 'library' (the shipped one), a library file, or a
+    `model-K.json` a `vcc induce` run wrote; checked against the run's order."""
+    import numpy as np
+
+    from search.library import load
+    from search.model import MarkovModel, Vocabulary
+    from vccjax.errors import DataFileError, read_json
+
+    if spec == "library":
+        lib = load()
+        vocab, model = lib.vocab, lib.model
+    else:
+        content = read_json(spec, DataFileError, "no such model file")
+        if isinstance(content, dict) and content.get("format") == "vccjax-library":
+            lib = load(spec)
+            vocab, model = lib.vocab, lib.model
+        else:
+            try:
+                vocab = Vocabulary.from_json(content["subroutines"])
+                logp = np.array(content["logp"], float)
+                order = int(content["order"])
+            except (KeyError, TypeError, ValueError) as e:
+                raise DataFileError(f"{spec}: not a library or a model-K.json of vcc induce ({e})") from None
+            if logp.shape != (vocab.size + 1, vocab.size + 1) or not np.all(np.isfinite(logp)):
+                raise DataFileError(f"{spec}: transition table of shape {logp.shape}, expected "
+                                    f"{(vocab.size + 1, vocab.size + 1)} finite values")
+            model = MarkovModel(logp, order, settings.epsilon)
+    if model.order != settings.order:
+        raise DataFileError(f"{spec}: a model of order {model.order}, this run has --order {settings.order}")
+    return vocab, model
+
+
 def add_commands(sub) -> None:
     p = sub.add_parser(
         "induce", help="induce programs for concepts from their examples (explore-compress)",
@@ -52,13 +96,17 @@ def add_commands(sub) -> None:
                     "command resumes.",
     )
     p.add_argument("--concepts", default="all",
-                   help="'all' (default), 'demo' (a dozen short ones) or a comma-separated list")
+                   help="'all' (default: the 546, or every concept of --dataset), 'demo' (a dozen short ones) "
+                        "or a comma-separated list")
     p.add_argument("--out", required=True, help="run folder (created; an existing one is resumed)")
     p.add_argument("--budget", type=int, default=500_000, help="programs per concept (default 500000)")
     p.add_argument("--order", type=int, choices=[0, 1], default=1, help="Markov order (default 1)")
-    p.add_argument("--args", default="oracle",
+    p.add_argument("--args", default="predicted",
                    choices=["uniform", "uniform+fixation", "oracle", "predicted", "predicted+fixation"],
-                   help="argument model (default oracle: the values the reference program uses)")
+                   help="argument model (default predicted: the CNN on the training pairs; oracle and "
+                        "+fixation read the program stored with each concept's examples, research settings)")
+    p.add_argument("--model", help="start from a learned model: 'library' (the shipped one), a library file, "
+                                   "or a run's model-K.json; then one pass over the concepts")
     p.add_argument("--subroutines", choices=["on", "off"], default="on")
     p.add_argument("--epsilon", type=float, default=0.1, help="pseudocount (default 0.1)")
     p.add_argument("--iterations", type=int, default=8, help="explore-compress iterations at most")

@@ -43,7 +43,7 @@ from vccjax.machine.scene import Scene, scenes_match
 class Settings:
     budget: int = 500_000
     order: int = 1
-    args: str = "oracle"
+    args: str = "predicted"
     subroutines: bool = True
     epsilon: float = 0.1
     max_iterations: int = 8
@@ -59,6 +59,11 @@ class Settings:
             raise ValueError("--budget must be positive")
 
 
+def needs_answer(settings: Settings) -> bool:
+    """Whether the settings read the concept's answer program (research settings only)."""
+    return settings.args == "oracle" or settings.args.endswith("+fixation")
+
+
 def argument_logp(settings: Settings, concept: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
                   answer: Program | None = None) -> dict[int, np.ndarray]:
     """log p(argument | instruction) for one concept under the settings' mode
@@ -66,7 +71,7 @@ def argument_logp(settings: Settings, concept: str, pairs: Sequence[tuple[Scene,
     reference program when it is one of the 546."""
     from search.arguments import argument_logp as logp
 
-    if answer is None and (settings.args == "oracle" or settings.args.endswith("+fixation")):
+    if answer is None and needs_answer(settings):
         answer = reference_program(concept)
     return logp(settings.args, pairs, answer)
 
@@ -163,6 +168,19 @@ class Run:
             info["predictor_sha256"] = sha256
             self._write_meta(info)
 
+    def check_start(self, name: str) -> None:
+        """Record the model the run started from ('uniform' or a learned model's hash);
+        refuse a resume from another (its records would mix two starts)."""
+        meta = self.out / "run.json"
+        info = json.loads(meta.read_text())
+        known = info.get("start_model", "uniform")
+        if self.records and known != name:
+            raise DataFileError(f"{meta}: this run started from model {known[:12]}, not {name[:12]}; "
+                                "use another --out or the same --model")
+        if info.get("start_model") != name:
+            info["start_model"] = name
+            self._write_meta(info)
+
     def _write_meta(self, info: dict) -> None:
         tmp = self.out / "run.json.tmp"
         tmp.write_text(json.dumps(info, indent=1))
@@ -215,12 +233,20 @@ def induce(
     out: str | Path, settings: Settings, explorer: Searcher | None = None,
     progress: bool = True, log: Callable[[str], None] = print,
     examples_sha256: Callable[[str], str] | None = None,
+    answers: Callable[[str], Program] | None = None,
+    start: tuple[Vocabulary, MarkovModel] | None = None,
 ) -> Run:
     """Explore-compress over `concepts`; `pairs(concept, split)` gives examples, and
-    `examples_sha256(concept)`, when given, names them so a resume can check them."""
+    `examples_sha256(concept)`, when given, names them so a resume can check them.
+    `answers(concept)` is the program stored with a concept's examples, read only by
+    `--args oracle` and fixation guidance (default: the 546's reference programs);
+    `start` is a model learned elsewhere (the shipped library, or a run's model file):
+    then one pass searches every concept with it, as `vcc learn` does (default: iteration
+    0 uniform over the atoms, then explore-compress)."""
     from tqdm import tqdm
 
     run = Run(out, settings)
+    run.check_start("uniform" if start is None else model_sha256(*start))
     if examples_sha256 is not None:
         run.check_examples({c: examples_sha256(c) for c in concepts})
     if settings.args.startswith("predicted"):
@@ -233,7 +259,7 @@ def induce(
         before = {r["concept"]: r for r in run.records if r["found"] and r["iteration"] < it}
         programs = [parse(before[c]["program"]) for c in sorted(before)]
         if it == 0:
-            vocab, model = Vocabulary(), MarkovModel.uniform(Vocabulary().size, settings.order)
+            vocab, model = start or (Vocabulary(), MarkovModel.uniform(Vocabulary().size, settings.order))
         else:
             vocab, model = fit_model(programs, settings, subs_on)
         (run.out / f"model-{it}.json").write_text(json.dumps({
@@ -258,14 +284,15 @@ def induce(
         jobs = []
         for c in todo:
             train = pairs(c, "train")
-            chain = Chain(vocab, model, argument_logp(settings, c, train), settings.delta)
+            answer = answers(c) if answers is not None and needs_answer(settings) else None
+            chain = Chain(vocab, model, argument_logp(settings, c, train, answer), settings.delta)
             jobs.append((chain, Task.from_pairs(train)))
         explorer.search_many(jobs, settings.budget, done)
         bar.close()
         n_new = sum(1 for r in run.records if r["iteration"] == it and r["found"])
         log(f"iteration {it}: {n_new} new, {len(run.found())} of {len(set(concepts))} found"
             + (f", model with {len(vocab.bodies)} subroutines" if vocab.bodies else ""))
-        if len(run.found()) >= len(set(concepts)):
+        if len(run.found()) >= len(set(concepts)) or start is not None:
             break
         if n_new == 0:
             if it > 0 and settings.subroutines and not subs_on:
@@ -273,6 +300,15 @@ def induce(
                 continue
             break
     return run
+
+
+def model_sha256(vocab: Vocabulary, model: MarkovModel) -> str:
+    """A model's identity: its subroutines and transition table."""
+    import hashlib
+
+    h = hashlib.sha256(json.dumps(vocab.to_json()).encode())
+    h.update(np.ascontiguousarray(model.logp, np.float64).tobytes())
+    return h.hexdigest()
 
 
 def wall_seconds(run: Run) -> float:

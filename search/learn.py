@@ -114,7 +114,7 @@ def chain_for(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings,
     """The search's chain for these pairs: the start model and the argument beliefs."""
     vocab, model, name = start or model_for(settings.library)
     mode = settings.args + ("+fixation" if settings.fixate else "")
-    return Chain(vocab, model, argument_logp(mode, pairs, None, settings.fixate), settings.delta), name
+    return Chain(vocab, model, argument_logp(mode, pairs, None, settings.fixate, fallback=True), settings.delta), name
 
 
 def alternatives_for(chain: Chain, settings: LearnSettings) -> Alternatives:
@@ -127,8 +127,9 @@ def verdict_for(result: Result, pairs: Sequence[tuple[Scene, Scene]], settings: 
     if not result.found:
         return None, []
     programs = [result.program] + [a.program for a in result.alternatives]
+    nats = [result.dl_nats] + [a.dl_nats for a in result.alternatives]
     return judge(programs, [a for a, _ in pairs], settings.fresh_scenes, settings.seed, settings.min_scenes,
-                 DEFAULT_CONFIG)
+                 DEFAULT_CONFIG, nats)
 
 
 def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searcher: Searcher | None = None,

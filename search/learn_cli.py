@@ -124,22 +124,27 @@ def _write_results(folder: Path, learned, record: dict, first_input) -> list[str
     if learned.ambiguous:
         v, scene = learned.verdict, learned.query_scene
         cands = learned.candidates()
-        outputs = [(_letter(k), cands[i][0].text(), o) for k, (i, o) in enumerate(zip(v.programs, v.query_outputs))]
+        answers = []  # one per distinct outcome on the query: the programs that give it
+        for number, group in enumerate(v.answers, 1):
+            labels = [_letter(k) for k in group]
+            answers.append({"answer": number, "programs": {_letter(k): cands[v.programs[k]][0].text() for k in group},
+                            "output": None if v.query_outputs[group[0]] is None
+                            else v.query_outputs[group[0]].to_dict(), "labels": labels})
         _write_json(folder, "query.json", {
             "question": "which output do you mean for this input? Add the input and that output as one more pair "
-                        "(copy query_in.json as <k>_in.json and the chosen output as <k>_out.json into your "
-                        "examples folder), then run vcc learn again",
-            "input": scene.to_dict(),
-            "answers": [{"label": lab, "program": text, "output": None if o is None else o.to_dict()}
-                        for lab, text, o in outputs]})
+                        "(copy query_in.json as <k>_in.json and the chosen query_out_<n>.json as <k>_out.json "
+                        "into your examples folder, or draw the output you mean), then run vcc learn again",
+            "input": scene.to_dict(), "answers": answers})
         _write_json(folder, "query_in.json", scene.to_dict())
-        write_query(folder / "query.png", scene, outputs)
+        panels = [(f"{a['answer']}: " + ", ".join(a["labels"]), next(iter(a["programs"].values())),
+                   v.query_outputs[group[0]]) for a, group in zip(answers, v.answers, strict=True)]
+        write_query(folder / "query.png", scene, panels)
         names += list(QUERY_FILES)
-        for lab, _, o in outputs:
-            if o is not None:
-                _write_json(folder, f"query_out_{lab}.json", o.to_dict())
-                names.append(f"query_out_{lab}.json")
-        record["query"] = {"files": names[1:], "answers": len(outputs)}
+        for a in answers:
+            if a["output"] is not None:
+                _write_json(folder, f"query_out_{a['answer']}.json", a["output"])
+                names.append(f"query_out_{a['answer']}.json")
+        record["query"] = {"files": names[1:], "answers": len(answers)}
     _write_json(folder, "concept.json", record)
     return ["concept.json", *names]
 

@@ -194,7 +194,7 @@ def test_cli_induce_runs_and_reports(tmp_path, capsys, monkeypatch):
     monkeypatch.setenv("VCCJAX_CACHE", "off")
     out = tmp_path / "cli"
     argv = ["induce", "--concepts", "remove_bottom_obj,remove_top_obj", "--out", str(out),
-            "--budget", "2000", "--iterations", "1", "--quiet"]
+            "--budget", "2000", "--iterations", "1", "--args", "oracle", "--quiet"]
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "induced" in text and "programs/s" in text
@@ -236,7 +236,7 @@ def test_cli_induce_refuses_a_dataset_without_the_concept_or_other_examples(tmp_
     argv = ["induce", "--concepts", "remove_top_obj", "--out", str(tmp_path / "run"), "--dataset", str(part)]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
-    assert "no examples for remove_top_obj" in err and len(err.splitlines()) == 1
+    assert "unknown concept(s): remove_top_obj (not in the dataset's manifest)" in err and len(err.splitlines()) == 1
     # a run started on the shipped examples does not resume on other ones
     run = ["induce", "--concepts", "remove_bottom_obj", "--out", str(tmp_path / "run"), "--budget", "500",
            "--iterations", "1", "--quiet"]

@@ -50,6 +50,10 @@ def _folder(path, pairs, keys=None, png=()):
     return path
 
 
+def same_output(m, answer) -> bool:
+    return not m.failed and scenes_match(m.output_scene(), answer.output_scene(), TAU)
+
+
 def _explains(program, pairs) -> bool:
     for a, b in pairs:
         m = RefMachine(a).run(program)
@@ -85,8 +89,12 @@ def test_two_ambiguous_pairs_get_a_question_and_the_answer_settles_it(data):
     answer = RefMachine(q).run(truth)
     assert not answer.failed
     settled = learn([*two, (q, answer.output_scene())], settings, ScalarExplorer(width=1))
-    assert settled.found and not settled.ambiguous
-    assert _explains(settled.program, data.pairs(CONCEPT, "test"))
+    assert settled.found and _explains(settled.program, data.pairs(CONCEPT, "test"))
+    assert not _explains(first.program, data.pairs(CONCEPT, "test"))  # the first guess was wrong
+    # every candidate the answer ruled out is gone: none gives the query's other outputs
+    wrong = [first.candidates()[first.verdict.programs[k]][0] for g in first.verdict.answers for k in g
+             if not same_output(RefMachine(q).run(first.candidates()[first.verdict.programs[k]][0]), answer)]
+    assert wrong and not {p.text() for p in wrong} & {p.text() for p, _, _ in settled.candidates()}
 
 
 def test_learn_writes_the_concept_saves_it_and_runs_it_by_name(data, tmp_path, capsys, monkeypatch):
@@ -123,8 +131,15 @@ def test_a_rerun_with_the_answer_replaces_the_question(data, tmp_path):
     (folder / "q_in.json").write_text((out / "query_in.json").read_text())
     RefMachine(scene).run(reference_program(CONCEPT)).output_scene().save(folder / "q_out.json")
     assert main(["learn", str(folder), "--out", str(out), *QUICK]) == 0
-    assert json.loads((out / "concept.json").read_text())["ambiguous"] is False
-    assert not [p.name for p in out.glob("query*")]
+    learned = json.loads((out / "concept.json").read_text())
+    assert _explains(parse(learned["program"]), data.pairs(CONCEPT, "test"))
+    if learned["ambiguous"]:  # a new question, and nothing left of the old one
+        again = json.loads((out / "query.json").read_text())
+        assert again["input"] != q["input"]
+        assert sorted(p.name for p in out.glob("query_out_*.json")) == sorted(
+            f"query_out_{a['answer']}.json" for a in again["answers"] if a["output"] is not None)
+    else:
+        assert not [p.name for p in out.glob("query*")]
 
 
 def _blank(path, color=None) -> None:

@@ -23,6 +23,6 @@ def test_notebook_runs_top_to_bottom(path, monkeypatch):
         "a notebook that draws nothing"
 
 
-def test_there_are_four_notebooks():
+def test_there_are_five_notebooks():
     assert [p.stem for p in sorted(NOTEBOOKS.glob("*.ipynb"))] == [
-        "01_emulator_traces", "02_induction", "03_argpred", "04_robot"]
+        "01_emulator_traces", "02_induction", "03_argpred", "04_robot", "05_teach"]

@@ -56,19 +56,21 @@ DEMO: tuple[str, ...] = (  # a dozen short concepts: `--concepts demo` (all foun
     "move_to_bottom_edge", "move_to_right_edge", "move_to_top_edge")
 
 
-def concept_list(spec: str) -> list[str]:
-    """Concepts named on a command line: 'all', 'demo' or a comma-separated list."""
-    names = concept_names()
+def concept_list(spec: str, available: list[str] | None = None) -> list[str]:
+    """Concepts named on a command line: 'all', 'demo' or a comma-separated list. With
+    `available` (a dataset's concepts), 'all' means those and every name must be one."""
+    names = concept_names() if available is None else list(available)
     if spec == "all":
         return names
-    if spec == "demo":
+    if spec == "demo" and available is None:
         return list(DEMO)
     chosen = list(dict.fromkeys(c.strip() for c in spec.split(",") if c.strip()))  # once each, in order
     if not chosen:
         raise ValueError(f"--concepts {spec!r}: names no concept ('all', 'demo' or a comma-separated list)")
     unknown = [c for c in chosen if c not in names]
     if unknown:
-        raise ValueError(f"unknown concept(s): {', '.join(unknown)} (see `vcc concepts`)")
+        where = "see `vcc concepts`" if available is None else "not in the dataset's manifest"
+        raise ValueError(f"unknown concept(s): {', '.join(unknown)} ({where})")
     return chosen
 
 

@@ -291,7 +291,11 @@ class Dataset:
     def program(self, concept: str) -> Program:
         """The program the concept's examples were made with (its answer: read only by
         research settings that ask for it, `--args oracle` and fixation guidance)."""
-        return parse(bytes(self.arrays(concept)["program"]).decode())
+        arrays = self.arrays(concept)
+        if "program" not in arrays or not bytes(arrays["program"]).decode().strip():
+            raise DataFileError(f"{self.folder}: {concept!r} has no program stored with its examples "
+                                "(--args oracle and fixation guidance read it)")
+        return parse(bytes(arrays["program"]).decode())
 
     def sha256(self, concept: str) -> str:
         """The manifest's hash of the concept's file: what identifies its examples."""
