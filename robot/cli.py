@@ -13,11 +13,22 @@ XLA_FLAG = "--xla_cpu_use_fusion_emitters=false"  # batched MJX 14x faster on CP
 
 
 def _program(a: argparse.Namespace):
-    if a.program:
-        return runtime.program_from_arg(a.program)
-    from robot.suite import programs_of
+    """The program(s) to carry out; one an arm cannot do is refused here, before MJX."""
+    from robot.plan import NOT_ON_A_ROBOT
+    from vccjax.machine.instructions import NAMES
 
-    return programs_of(a.concept, a.induced)
+    if a.program:
+        program = runtime.program_from_arg(a.program)
+    else:
+        from robot.suite import programs_of
+
+        program = programs_of(a.concept, a.induced)
+    for p in program if isinstance(program, list) else [program]:
+        for op in p.ops:
+            if NAMES[op] in NOT_ON_A_ROBOT:
+                raise ValueError(f"{a.concept or 'the program'}: {NAMES[op]} {NOT_ON_A_ROBOT[NAMES[op]]}, "
+                                 "not something an arm can do")
+    return program
 
 
 def cmd_run(a: argparse.Namespace) -> int:

@@ -301,3 +301,21 @@ def test_programs_come_from_an_induce_run_when_asked(tmp_path):
     (tmp_path / "results.jsonl").write_text("{not json\n")
     with pytest.raises(DataFileError, match="line 1 is not a result"):
         programs_of("move_bottom_to_pointed", tmp_path)
+
+
+def test_a_concept_saved_by_vcc_learn_is_carried_out_by_name(tmp_path, monkeypatch, capsys):
+    from robot.suite import programs_of
+    from vcc.cli import main
+    from vccjax.machine.program import parse
+    from vccjax.world.user_concepts import save_concept
+
+    monkeypatch.setenv("VCC_LIBRARY", str(tmp_path))
+    learned = "scene_parse; fixate(right); top_down_attend; move_hand_to_attended_object; grab_object; move_hand_up"
+    save_concept("lift_right_most", {"program": learned, "pairs": 3})
+    assert programs_of("lift_right_most") == parse(learned)
+    assert programs_of("lift_right_most+move_to_middle")[1] == reference_program("move_to_middle")
+    save_concept("paint_it", {"program": "scene_parse; top_down_attend; fill_color(red)"})
+    assert main(["robot", "run", "--concept", "paint_it", "--scenarios", "1"]) == 2  # refused before MJX starts
+    assert "recolours an object" in capsys.readouterr().err
+    assert main(["robot", "run", "--concept", "no_such_saved"]) == 2
+    assert "not in your library" in capsys.readouterr().err

@@ -53,3 +53,35 @@ def test_unknown_color_is_an_error():
 def test_not_an_image_is_an_error():
     with pytest.raises(SceneError, match="expected an RGB uint8 image"):
         parse_image(np.zeros((64, 64), np.uint8))
+
+
+def test_a_picture_that_is_not_square_is_refused_not_squeezed():
+    import numpy as np
+    import pytest
+
+    from vccjax.errors import SceneError
+    from vccjax.vision.perception import parse_image
+
+    img = np.full((256, 341, 3), 255, np.uint8)
+    img[100:140, 100:140] = (220, 40, 40)
+    with pytest.raises(SceneError, match="341 x 256 pixels; the workspace is square"):
+        parse_image(img)
+
+
+@pytest.mark.parametrize("style", ["jitter", "shades", "outline", "photo"])
+def test_pictures_drawn_apart_from_our_renderer_are_parsed(style):
+    """Drawn with Pillow in other styles: a single large object of each shape is found
+    with its shape, colour and centre (whole scenes are measured by `vcc perception eval`)."""
+    from vccjax.machine.config import DEFAULT_CONFIG
+    from vccjax.vision.drawings import draw
+    from vccjax.vision.perception import parse_image
+
+    for k, shape in enumerate(("square", "circle", "diamond", "triangle", "star")):
+        sc = scene(obj(shape, ("red", "green", "blue", "yellow", "red")[k], 0.4 + 0.05 * k, 0.5, 0.18),
+                   pointer=(0.85, 0.15))
+        got = parse_image(draw(sc, style, 256, seed=k))
+        assert len(got.objects) == 1, (style, shape, got)
+        o, t = got.objects[0], sc.objects[0]
+        assert (o.shape, o.color) == (t.shape, t.color), (style, shape, o)
+        assert (o.x - t.x) ** 2 + (o.y - t.y) ** 2 <= DEFAULT_CONFIG.tau ** 2
+        assert got.pointer is not None and abs(got.pointer[0] - 0.85) < 0.02 and abs(got.pointer[1] - 0.15) < 0.02

@@ -114,3 +114,37 @@ def end_to_end(
         "mean_pair_agreement": float(np.mean(list(share.values()))),
         "misses": {n: miss for n, _, miss in results if miss},
     }
+
+
+def exact_scenes(n: int, style: str, size: int = 256, seed: int = 0, progress: bool = True) -> dict:
+    """The share of scenes parsed exactly from pictures drawn in another style
+    (`vccjax.vision.drawings`): every object found (shape, colour, centre within tau),
+    no phantom object, and the pointer found (within tau) exactly when there is one."""
+    from tqdm import tqdm
+
+    from vccjax.vision.drawings import draw
+
+    tau = DEFAULT_CONFIG.tau
+    rng = np.random.default_rng([seed, 7, size])
+    exact = 0
+    misses: dict[str, int] = {}
+    for _ in tqdm(range(n), desc=f"{style} {size}px", disable=not progress):
+        sc = random_scene(rng, (2, 8), widths=(0.04, 0.20), pointer=bool(rng.random() < 0.5))
+        img = draw(sc, style, size, seed=int(rng.integers(2**31)))
+        try:
+            parsed = parse_image(img)
+        except SceneError as e:
+            misses[f"error: {e}"[:50]] = misses.get(f"error: {e}"[:50], 0) + 1
+            continue
+        hits, phantoms = _match(sc.objects, parsed.objects, tau)
+        p, q = sc.pointer, parsed.pointer
+        pointer_ok = (p is None and q is None) or (
+            p is not None and q is not None and (p[0] - q[0]) ** 2 + (p[1] - q[1]) ** 2 <= tau * tau)
+        why = ("object missed" if hits < len(sc.objects) else "phantom object" if phantoms
+               else "phantom pointer" if p is None and q is not None else "pointer missed" if not pointer_ok else "")
+        if why:
+            misses[why] = misses.get(why, 0) + 1
+        else:
+            exact += 1
+    return {"style": style, "size": size, "scenes": n, "exact": exact, "exact_share": round(exact / n, 4),
+            "misses": dict(sorted(misses.items(), key=lambda kv: -kv[1]))}

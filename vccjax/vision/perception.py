@@ -31,6 +31,9 @@ class ParseOptions:
     min_saturation: int = 90
     min_value: int = 60
     min_area_px: int = 12  # regions smaller than this are noise
+    edge_saturation: int = 40  # a region grows into connected pixels of its hue down to this (blurred edges)
+    outline_value: int = 90  # darker pixels hugging a region are its outline, part of the object
+    outline_width: float = 0.008  # of the image's side: how far an outline may reach out
 
 
 def _hue_mask(hsv: np.ndarray, bands) -> np.ndarray:
@@ -89,22 +92,31 @@ def parse_image(image: np.ndarray, options: ParseOptions = ParseOptions()) -> Sc
     if not isinstance(image, np.ndarray) or image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
         raise SceneError(f"expected an RGB uint8 image (H, W, 3), got {getattr(image, 'shape', type(image))}")
     size_y, size_x = image.shape[:2]
+    if size_x != size_y:
+        raise SceneError(f"the image is {size_x} x {size_y} pixels; the workspace is square: crop the picture "
+                         "to the workspace (or pad it) so it is square")
     hsv = cv2.cvtColor(image, cv2.COLOR_RGB2HSV)
     saturated = (hsv[..., 1] >= options.min_saturation) & (hsv[..., 2] >= options.min_value)
+    faint = (hsv[..., 1] >= options.edge_saturation) & (hsv[..., 2] >= options.min_value // 2)
+    dark = hsv[..., 2] < options.outline_value
+    reach = max(1, int(round(options.outline_width * size_x)))
     objects: list[SceneObject] = []
     claimed = np.zeros(saturated.shape, bool)
     for color, bands in HUE_BANDS.items():
         # no morphological opening here: OpenCV's erode/dilate with an even kernel shift the
         # region by a pixel, and tiny specks are dropped by area below anyway
-        m = (saturated & _hue_mask(hsv, bands)).astype(np.uint8)
-        n, labels, stats, _ = cv2.connectedComponentsWithStats(m, connectivity=8)
+        hue = _hue_mask(hsv, bands)
+        strong = (saturated & hue).astype(np.uint8)
+        n, labels, stats, _ = cv2.connectedComponentsWithStats(strong, connectivity=8)
         for k in range(1, n):
             x0, y0, w, h, area = stats[k]
-            if area < options.min_area_px:
-                continue
-            region = labels[y0 : y0 + h, x0 : x0 + w] == k
-            claimed[y0 : y0 + h, x0 : x0 + w] |= region
-            shape, cx, cy, width = _classify(region, x0, y0)
+            if area < options.min_area_px or claimed[labels == k].any():
+                continue  # noise, or a core already taken into a region grown from another
+            region = _grown(labels == k, faint & hue, dark, reach)
+            ys, xs = np.nonzero(region)
+            x0, y0, x1, y1 = xs.min(), ys.min(), xs.max() + 1, ys.max() + 1
+            claimed |= region
+            shape, cx, cy, width = _classify(region[y0:y1, x0:x1], x0, y0)
             objects.append(SceneObject(shape, color, cx / size_x, cy / size_y, width / size_x))
     leftover = saturated & ~claimed
     leftover = cv2.morphologyEx(leftover.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
@@ -118,6 +130,25 @@ def parse_image(image: np.ndarray, options: ParseOptions = ParseOptions()) -> Sc
         raise SceneError("no objects found in the image")
     objects.sort(key=lambda o: (o.y, o.x))  # a stable, image-independent order
     return Scene(tuple(_clamp(o) for o in objects), _find_pointer(hsv, claimed))
+
+
+def _grown(seed: np.ndarray, faint: np.ndarray, dark: np.ndarray, reach: int) -> np.ndarray:
+    """A region grown from its saturated core into the connected faint pixels of its hue
+    (edges and thin star points that blur and JPEG desaturate), then into the dark pixels
+    hugging it within `reach` (an outline drawn around the shape)."""
+    ys, xs = np.nonzero(seed)
+    pad = 2 * reach + 2
+    y0, x0 = max(ys.min() - pad, 0), max(xs.min() - pad, 0)
+    y1, x1 = min(ys.max() + pad + 1, seed.shape[0]), min(xs.max() + pad + 1, seed.shape[1])
+    core = seed[y0:y1, x0:x1]
+    n, labels = cv2.connectedComponents((faint[y0:y1, x0:x1] | core).astype(np.uint8), connectivity=8)
+    keep = np.unique(labels[core])
+    region = np.isin(labels, keep[keep > 0]) | core
+    ring = cv2.dilate(region.astype(np.uint8), np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)) > 0
+    region |= ring & dark[y0:y1, x0:x1]
+    out = np.zeros(seed.shape, bool)
+    out[y0:y1, x0:x1] = region
+    return out
 
 
 def _labels_eq(mask: np.ndarray, stat) -> np.ndarray:
