@@ -103,10 +103,12 @@ class _Budget:
     def found(self, cost: int, path: np.ndarray) -> None:
         """A program that explains every example: keep it if it is the cheapest so far."""
         fit = (cost, path.copy())
-        if self.alternatives is not None:
-            self.fits.append(fit)
         if self.best is None or cost < self.best[0]:
             self.best = fit
+        alt = self.alternatives
+        if alt is not None:  # the `keep` cheapest within the margin (stable: ties in finding order)
+            within = [f for f in [*self.fits, fit] if f[0] <= self.best[0] + alt.margin_bins]
+            self.fits = sorted(within, key=lambda f: f[0])[: alt.keep]
         self.cutoff = min(self.cutoff, self._limit())
 
     def _limit(self) -> int:
@@ -116,19 +118,15 @@ class _Budget:
         alt = self.alternatives
         if alt is None or self.extra_left <= 0:
             return best - 1
-        costs = sorted(c for c, _ in self.fits if c <= best + alt.margin_bins)
-        if len(costs) >= alt.keep:
-            return min(best + alt.margin_bins, costs[alt.keep - 1] - 1)
+        if len(self.fits) >= alt.keep:
+            return min(best + alt.margin_bins, self.fits[-1][0] - 1)
         return best + alt.margin_bins
 
     def kept(self) -> tuple[tuple[int, np.ndarray], ...]:
         """The alternatives kept, cheapest first (ties in finding order), the best excluded."""
         if self.best is None or self.alternatives is None:
             return ()
-        best, alt = self.best, self.alternatives
-        others = [f for f in self.fits if f is not best and f[0] <= best[0] + alt.margin_bins]
-        others = sorted(others, key=lambda f: f[0])  # stable: ties keep finding order
-        return tuple(others[: max(alt.keep - 1, 0)])
+        return tuple(f for f in self.fits if f is not self.best)[: max(self.alternatives.keep - 1, 0)]
 
 
 def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chunk: int, slice_size: int,
