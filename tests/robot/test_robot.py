@@ -178,7 +178,7 @@ def test_run_reads_a_long_program_as_text_a_file_as_a_file_and_refuses_a_missing
     args = argparse.Namespace(program=text, concept="x", induced=None)
     got = _program(args)
     assert got == parse(text) and len(got) == len(steps) + 6 * (len(steps) - 1)
-    short = "scene_parse; top_down_attend; fill_color(blue)"
+    short = "scene_parse; top_down_attend; move_hand_to_attended_object; grab_object; move_hand_left"
     for name in ("p", "p.vcc"):
         (tmp_path / name).write_text(short + "\n")
         assert _program(argparse.Namespace(program=str(tmp_path / name), concept="x", induced=None)) == parse(short)
