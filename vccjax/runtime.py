@@ -41,14 +41,15 @@ def pin_to_cores(n: int) -> None:
 
 def enable_compile_cache() -> None:
     """Keep compiled XLA programs across runs (JAX's persistent cache); VCCJAX_CACHE=off
-    turns it off, another value moves it."""
+    turns it off, another value moves it. Every compile is kept, however short: a search
+    compiles many small steps, and reloading them halves a warm `vcc learn`."""
     where = os.environ.get("VCCJAX_CACHE", str(Path.home() / ".cache" / "vccjax" / "jax"))
     if where.lower() == "off":
         return
     import jax
 
     jax.config.update("jax_compilation_cache_dir", where)
-    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
 
 
 def prepare(xla_flags: Sequence[str] = (), cores: int | None = None, compile_cache: bool = True) -> None:
