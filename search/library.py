@@ -23,6 +23,7 @@ import numpy as np
 
 from search.model import MarkovModel, Vocabulary, transition_counts
 from vccjax.errors import DataFileError
+from vccjax.sealed import intact, seal, write_whole
 
 FORMAT = "vccjax-library"
 VERSION = 1
@@ -88,7 +89,7 @@ def build(run_folder: str | Path) -> dict:
         "results_sha256": hashlib.sha256((folder / "results.jsonl").read_bytes()).hexdigest(),
         "predictor_sha256": load_weights()[2]["sha256"],
     }
-    return _sealed({
+    return seal({
         "format": FORMAT, "version": VERSION, "order": order, "epsilon": epsilon,
         "subroutines": vocab.to_json(),
         "transitions": [[int(i), int(j), int(counts[i, j])] for i, j in zip(rows, cols, strict=True)],
@@ -96,22 +97,9 @@ def build(run_folder: str | Path) -> dict:
     })
 
 
-def _content_sha256(content: dict) -> str:
-    body = {k: v for k, v in content.items() if k != "content_sha256"}
-    return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
-
-
-def _sealed(content: dict) -> dict:
-    return {**content, "content_sha256": _content_sha256(content)}
-
-
 def save(content: dict, path: str | Path) -> str:
     """Write a library file whole (a temporary file replaced); returns its content sha256."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(content, indent=1, sort_keys=True) + "\n")
-    tmp.replace(path)
+    write_whole(Path(path), content)
     return content["content_sha256"]
 
 
@@ -129,7 +117,7 @@ def load(path: str | Path | None = None, check_predictor: bool = True) -> Librar
     if content.get("version") != VERSION:
         raise DataFileError(f"{path}: library format version {content.get('version')}, this vccjax reads {VERSION} "
                             "(rebuild it with `vcc library build`)")
-    if content.get("content_sha256") != _content_sha256(content):
+    if not intact(content):
         raise DataFileError(f"{path}: content sha256 mismatch (edited or corrupt)")
     try:
         vocab = Vocabulary.from_json(content["subroutines"])

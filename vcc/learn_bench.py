@@ -58,19 +58,9 @@ def _open_run(folder: Path, meta: dict) -> list[dict]:
     return records
 
 
-def _right(program, pairs, tau: float) -> int:
-    from vccjax.machine.reference import RefMachine
-    from vccjax.machine.scene import scenes_match
-
-    good = 0
-    for a, b in pairs:
-        m = RefMachine(a).run(program)
-        good += (not m.failed) and scenes_match(m.output_scene(), b, tau)
-    return good
-
-
 def cmd_bench_learn(a: argparse.Namespace) -> int:
     from search.explore import Explorer
+    from search.induce import generalization
     from search.learn import LearnSettings, chain_for, learn, model_for
     from search.task import Task
     from vccjax import runtime
@@ -118,7 +108,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
 
             def finished(j: int, r, todo=todo, k=k, start=start) -> None:
                 c = todo[j]
-                right = _right(r.program, ds.pairs(c, "test"), tau) if r.found else 0
+                right = generalization(r.program, ds.pairs(c, "test"), tau) if r.found else 0
                 write({"kind": "learn", "concept": c, "examples": k, "start": start, "found": r.found,
                        "right": bool(r.found and right == len(ds.pairs(c, "test"))), "test_right": right,
                        "program": r.program.text() if r.found else None, "rank": r.rank,
@@ -138,7 +128,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
         first = learn(pairs, settings, explorer)
         test = ds.pairs(c, "test")
         rec = {"kind": "ask", "concept": c, "examples": k, "start": "library", "found": first.found,
-               "right": bool(first.found and _right(first.program, test, tau) == len(test)),
+               "right": bool(first.found and generalization(first.program, test, tau) == len(test)),
                "ambiguous": first.ambiguous, "rivals": len(first.rivals()), "settled": None,
                "program": first.program.text() if first.found else None}
         if first.ambiguous:
@@ -150,7 +140,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
                 rec["settled"], rec["answer"] = False, "the concept's program fails on the query"
             else:
                 again = learn([*pairs, (q, m.output_scene())], settings, explorer)
-                rec["settled"] = bool(again.found and _right(again.program, test, tau) == len(test))
+                rec["settled"] = bool(again.found and generalization(again.program, test, tau) == len(test))
                 rec["settled_program"] = again.program.text() if again.found else None
                 rec["still_ambiguous"] = again.ambiguous
         write(rec)

@@ -14,6 +14,7 @@ from search import library
 from search.induce import Settings, fit_model
 from vcc.cli import main
 from vccjax.errors import DataFileError
+from vccjax.sealed import seal
 from vccjax.machine.program import parse
 from vccjax.world.concepts import concept_names, reference_program
 
@@ -66,7 +67,7 @@ def test_a_library_of_another_version_or_predictor_is_refused(run_folder, tmp_pa
             content["card"]["predictor_sha256"] = "0" * 64
         else:
             content[field] = value
-        library.save(library._sealed(content), path)  # sealed again: only the check itself can refuse
+        library.save(seal(content), path)  # sealed again: only the check itself can refuse
         with pytest.raises(DataFileError, match=message):
             library.load(path)
     path.write_text("{not json")

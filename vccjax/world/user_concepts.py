@@ -9,7 +9,6 @@ reported, plus the sha256 of that content: an edited or foreign file is refused 
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import re
@@ -17,6 +16,7 @@ from pathlib import Path
 
 from vccjax.errors import DataFileError, VCCError
 from vccjax.machine.program import Program, parse
+from vccjax.sealed import intact, seal, write_whole
 
 FORMAT = "vccjax-concept"
 VERSION = 1
@@ -43,11 +43,6 @@ def check_name(name: str) -> str:
     return name
 
 
-def _sha(content: dict) -> str:
-    body = {k: v for k, v in content.items() if k != "content_sha256"}
-    return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
-
-
 def save_concept(name: str, learned: dict, folder: Path | None = None) -> Path:
     """Write `learned` (what `vcc learn` wrote to concept.json) as concept `name`; an
     existing concept of that name is replaced whole."""
@@ -57,11 +52,8 @@ def save_concept(name: str, learned: dict, folder: Path | None = None) -> Path:
     folder.mkdir(parents=True, exist_ok=True)
     content = {"format": FORMAT, "version": VERSION, "name": name, **{k: v for k, v in learned.items()
                                                                       if k not in ("format", "version", "name")}}
-    content["content_sha256"] = _sha(content)
     path = folder / f"{name}.json"
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(content, indent=1, sort_keys=True) + "\n")
-    tmp.replace(path)
+    write_whole(path, seal(content))
     return path
 
 
@@ -79,7 +71,7 @@ def load_concept(name: str, folder: Path | None = None) -> dict:
         raise DataFileError(f"{path}: not a {FORMAT} file")
     if content.get("version") != VERSION:
         raise DataFileError(f"{path}: concept format version {content.get('version')}, this vccjax reads {VERSION}")
-    if content.get("content_sha256") != _sha(content) or content.get("name") != name:
+    if not intact(content) or content.get("name") != name:
         raise DataFileError(f"{path}: content sha256 mismatch (edited or corrupt)")
     return content
 
