@@ -3,10 +3,12 @@ started from the learned library, and a question back when the examples are ambi
 
 Nothing here reads an answer: arguments come from the argument CNN on the pairs (or
 uniform), fixation from the user's hint when given. The search finds the most probable
-program under the library's model that explains every pair (as `vcc induce` would), and
-keeps searching, within a bounded extra budget, for other programs that explain them too
-(`search.dfs.Alternatives`); `search.ambiguity` then tells whether those behave
-differently on fresh scenes and which scene to ask about.
+program under the library's model that explains every pair (as `vcc induce` would). A
+second pass then looks for other programs that explain them too (`search.dfs.Alternatives`)
+among the programs ranked up to `rival_budget` past the first fit, past the budget's own
+cutoff if need be: a rival a little less probable than the first must not be missed because
+the first was found near the end of the budget. `search.ambiguity` then tells whether the
+rivals behave differently on fresh scenes and which scene to ask about.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ from search.chain import Chain
 from search.dfs import Alternatives
 from search.explore import Searcher
 from search.model import MarkovModel, Vocabulary
-from search.result import Result
+from search.result import Alternative, Result
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.machine.program import Program
@@ -37,7 +39,7 @@ class LearnSettings:
     fixate: tuple[str, ...] | None = None  # the teacher's hint: fixate only to these
     library: str = "shipped"  # "shipped", "uniform" (from scratch) or a library file
     rival_margin_nats: float = 6.0  # rivals at most this much less probable than the first
-    rival_budget: int = 100_000  # programs judged after the first fit, at most, to find rivals
+    rival_budget: int = 2_000_000  # programs ranked past the first fit that the rival pass judges
     max_rivals: int = 32
     fresh_scenes: int = 100
     min_scenes: int = 2  # fresh scenes a rival must part on to make the examples ambiguous
@@ -117,9 +119,30 @@ def chain_for(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings,
     return Chain(vocab, model, argument_logp(mode, pairs, None, settings.fixate, fallback=True), settings.delta), name
 
 
-def alternatives_for(chain: Chain, settings: LearnSettings) -> Alternatives:
+def alternatives_for(chain: Chain, settings: LearnSettings, budget: int) -> Alternatives:
     margin = int(math.ceil(settings.rival_margin_nats / chain.delta))
-    return Alternatives(margin, settings.max_rivals, settings.rival_budget)
+    return Alternatives(margin, settings.max_rivals, budget)
+
+
+def with_rivals(first: Result, chain: Chain, task: Task, settings: LearnSettings, searcher: Searcher,
+                progress: Callable[[int], None] | None = None) -> Result:
+    """`first` (a finished search's result) with the rivals of a second pass over the
+    programs ranked up to `first.rank + rival_budget`, within the margin of the first.
+
+    The depth-first search prunes by its cutoff as it goes, so a cutoff raised after the
+    first fit would miss programs in branches already cut: the pass starts over with the
+    higher cutoff. The first program stays the answer (the pass finds it again, or one of
+    the same cost, which then counts as a rival)."""
+    if not first.found or settings.rival_budget == 0:
+        return first
+    budget = first.rank + settings.rival_budget
+    again = searcher.search(chain, task, budget, progress, alternatives_for(chain, settings, budget))
+    others = [Alternative(again.program, again.text, again.dl_nats)] if again.found else []
+    others += list(again.alternatives)
+    kept = tuple(a for a in others if a.program != first.program)[: settings.max_rivals - 1]
+    return dataclasses.replace(first, alternatives=kept, programs=first.programs + again.programs,
+                               nodes=first.nodes + again.nodes, seconds=first.seconds + again.seconds,
+                               compile_seconds=first.compile_seconds + again.compile_seconds)
 
 
 def verdict_for(result: Result, pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings
@@ -142,7 +165,8 @@ def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searche
         from search.explore import Explorer
 
         searcher = Explorer(width=1)
-    result = searcher.search(chain, Task.from_pairs(pairs), settings.budget, progress,
-                             alternatives_for(chain, settings))
+    task = Task.from_pairs(pairs)
+    result = with_rivals(searcher.search(chain, task, settings.budget, progress), chain, task, settings, searcher,
+                         progress)
     verdict, scenes = verdict_for(result, pairs, settings)
     return Learned(result, name, verdict, scenes)

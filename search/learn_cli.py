@@ -209,8 +209,9 @@ def add_commands(sub) -> None:
                    help="arguments: predicted by the CNN from the pairs (default) or uniform")
     p.add_argument("--fixate", help="the teacher's hint: where to look first (left, right, top, bottom, center; "
                                     "several comma-separated)")
-    p.add_argument("--rival-budget", type=int, default=100_000,
-                   help="programs searched after the first fit, looking for rivals (default 100000; 0: none)")
+    p.add_argument("--rival-budget", type=int, default=2_000_000,
+                   help="a second pass looks for rivals among the programs ranked up to this many past the first "
+                        "fit (default 2000000; 0: none)")
     p.add_argument("--fresh-scenes", type=int, default=100, help="scenes the rivals are compared on (default 100)")
     p.add_argument("--seed", type=int, default=0, help="seed of the fresh scenes (default 0)")
     p.add_argument("--name", help="a name for the concept (with --save)")

@@ -75,13 +75,18 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     runtime.prepare()
     run = Path(a.run)
     data = Path(a.dataset) if a.dataset else run / "examples"
-    build_dataset(data, seed=0, programs=programs, progress=not a.quiet)
+    built = build_dataset(data, seed=0, programs=programs, progress=not a.quiet)
+    for c, why in built["rivals_left"].items():
+        print(f"warning: {c}: no training pair tells its program from: {'; '.join(why)}")
     ds = Dataset(data)
     failed = [c for c in programs if c not in ds.manifest["concepts"]]
     if failed:
         raise DataFileError(f"{data}: no examples could be made for {', '.join(failed)}")
     names = list(programs)
+    asking = LearnSettings(budget=a.budget)
     meta = {"budget": a.budget, "examples": examples, "ask_examples": a.ask_examples,
+            "rivals": {"margin_nats": asking.rival_margin_nats, "budget": asking.rival_budget,
+                       "keep": asking.max_rivals, "fresh_scenes": asking.fresh_scenes, "min_scenes": asking.min_scenes},
             "programs_sha256": hashlib.sha256(Path(a.programs).read_bytes()).hexdigest(),
             "examples_sha256": {c: ds.sha256(c) for c in names}}
     records = _open_run(run, meta)
@@ -123,7 +128,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     for c in names:
         if ("ask", c, k, "library") in done:
             continue
-        settings = LearnSettings(budget=a.budget)
+        settings = asking
         pairs = ds.pairs(c, "train")[:k]
         first = learn(pairs, settings, explorer)
         test = ds.pairs(c, "test")

@@ -113,3 +113,22 @@ def test_keep_and_extra_budget_bound_the_alternatives(chain, two_pairs):
     none = ScalarExplorer().search(chain, task, BUDGET, alternatives=Alternatives(200, 10_000, 1))
     plain = ScalarExplorer().search(chain, task, BUDGET)
     assert none.text == plain.text and none.programs <= plain.programs + 256  # one slice at most
+
+
+def test_the_rival_pass_looks_past_the_budgets_cutoff(chain, two_pairs):
+    from search.learn import LearnSettings, alternatives_for, with_rivals
+
+    task = Task.from_pairs(two_pairs)
+    plain = ScalarExplorer().search(chain, task, BUDGET)
+    from search.chain import cutoff_for_budget
+
+    ends_at_first = int(cutoff_for_budget(chain, BUDGET)[1][plain.dl_bins])  # programs costing at most the first
+    first = ScalarExplorer().search(chain, task, ends_at_first)
+    assert first.found and first.text == plain.text and first.cutoff_bins == first.dl_bins
+    settings = LearnSettings(rival_margin_nats=2.0, rival_budget=BUDGET, max_rivals=10_000)
+    r = with_rivals(first, chain, task, settings, ScalarExplorer())
+    margin = alternatives_for(chain, settings, BUDGET).margin_bins
+    brute = {p.text() for p, _ in _every_program_up_to(chain, first.dl_bins + margin) if _explains(p, two_pairs)}
+    kept = sorted(a.program.text() for a in r.alternatives)
+    assert kept and kept == sorted(brute - {first.program.text()})  # every rival, all beyond the first's cutoff
+    assert (r.text, r.rank, r.dl_bins) == (first.text, first.rank, first.dl_bins) and r.programs > first.programs

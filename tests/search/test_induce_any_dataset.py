@@ -101,3 +101,15 @@ def test_induce_refuses_a_concept_outside_the_dataset_and_a_foreign_model(built,
     assert main(["induce", "--dataset", str(built / "ds"), "--model", str(tmp_path / "m.json"),
                  "--out", str(tmp_path / "r")]) == 2
     assert "transition table of shape" in capsys.readouterr().err
+
+
+def test_an_instruction_no_training_pair_needs_is_warned_of(tmp_path, capsys):
+    # Without reset_attn, the second top_down_attend refreshes a fresh attended list and
+    # keeps the top object (docs/vcc.md, "Refreshing A"): fill_color(blue) overwrites the
+    # red, so the program's first fill_color changes no example.
+    (tmp_path / "p.txt").write_text("recolor_top_red_and_bottom_blue: scene_parse; fixate(top); top_down_attend; "
+                                    "fill_color(red); fixate(bottom); top_down_attend; fill_color(blue)\n")
+    assert main(["dataset", "build", "--programs", str(tmp_path / "p.txt"), "--out", str(tmp_path / "ds"),
+                 "--workers", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "warning: recolor_top_red_and_bottom_blue" in out and "without fill_color at 3" in out
