@@ -140,6 +140,10 @@ def cmd_dataset_build(a: argparse.Namespace) -> int:
     left = m["rivals_left"]
     print(f"training pairs tell every rival of the reference apart in {len(m['concepts']) - len(left)} concepts;"
           f" {len(left)} leave some untold (manifest.json: rivals_left)")
+    if programs is not None:
+        for name, why in left.items():
+            print(f"warning: {name}: no training pair tells its program from: {'; '.join(why)} "
+                  "(an instruction that changes no example is often a slip in the program)")
     for name, why in m["failed"].items():
         print(f"not built: {name}: {why}")
     return 1 if m["failed"] else 0
@@ -176,6 +180,10 @@ def cmd_perception_evaluate(a: argparse.Namespace) -> int:
         for size in sizes:
             if a.dataset:
                 r = end_to_end(a.dataset, style, pairs=a.pairs, size=size, workers=a.workers)
+            elif a.touching:
+                r = exact_scenes(a.images, style, size, seed=a.seed, touching=True)
+            elif a.pointer_on_object:
+                r = exact_scenes(a.images, style, size, seed=a.seed, on_object_share=1.0)
             elif style in DRAWN:  # drawn apart from our renderer: the share of scenes parsed exactly
                 r = exact_scenes(a.images, style, size, seed=a.seed)
             else:
@@ -184,8 +192,9 @@ def cmd_perception_evaluate(a: argparse.Namespace) -> int:
             print(json.dumps(r))
     if a.out:
         Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(a.out).write_text(json.dumps({"command": "vcc perception eval --styles " + a.styles + f" --size {a.size}"
-                                           f" --images {a.images} --seed {a.seed}", "results": results}, indent=1))
+        command = (f"vcc perception eval --styles {a.styles} --size {a.size} --images {a.images} --seed {a.seed}"
+                   + " --touching" * a.touching + " --pointer-on-object" * a.pointer_on_object)
+        Path(a.out).write_text(json.dumps({"command": command, "results": results}, indent=1))
     return 0
 
 
@@ -261,6 +270,11 @@ def add_commands(sub) -> None:
     ev.add_argument("--size", default="384", help="image size in pixels, or several comma-separated (default 384)")
     ev.add_argument("--out", help="also write the results to this JSON file")
     ev.add_argument("--dataset", help="a built dataset folder: run the end-to-end check instead")
+    ev.add_argument("--touching", action="store_true",
+                    help="scenes holding two touching objects of one colour, scored as scenes parsed exactly")
+    ev.add_argument("--pointer-on-object", action="store_true",
+                    help="every pointer on an object (as attend_pointer examples draw it), scored as scenes "
+                         "parsed exactly")
     ev.add_argument("--pairs", type=int, default=50, help="test pairs per concept (end to end)")
     ev.add_argument("--workers", type=int, default=1, help="processes for the end-to-end check")
     ev.set_defaults(fn=cmd_perception_evaluate)

@@ -12,6 +12,7 @@ import numpy as np
 
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import SceneError
+from vccjax.machine.scene import Scene, SceneObject
 from vccjax.world.scenes import random_scene
 from vccjax.vision.perception import parse_image
 from vccjax.vision.render import render
@@ -116,21 +117,51 @@ def end_to_end(
     }
 
 
-def exact_scenes(n: int, style: str, size: int = 256, seed: int = 0, progress: bool = True) -> dict:
+def touching_pair(rng: np.random.Generator) -> Scene:
+    """Two objects of one colour side by side, touching (their boxes meet, up to half a
+    machine pixel apart), and a third of another colour elsewhere."""
+    from vccjax.machine.geometry import shape_polygon
+    from vccjax.machine.instructions import COLORS, SHAPES
+
+    def half_width(shape: str, w: float) -> float:
+        return w / 2 if shape == "circle" else float(shape_polygon(shape, 0.0, 0.0, w, 1.0)[:, 0].max())
+
+    color, other = (str(c) for c in rng.choice(COLORS, 2, replace=False))
+    s1, s2, s3 = (str(s) for s in rng.choice(SHAPES, 3))
+    w1, w2, w3 = rng.uniform(0.08, 0.18, 3)
+    x1, y = rng.uniform(0.15, 0.35), rng.uniform(0.25, 0.45)
+    x2 = x1 + half_width(s1, w1) + half_width(s2, w2) + rng.uniform(0, 0.5 / DEFAULT_CONFIG.units)
+    return Scene((SceneObject(s1, color, x1, y, w1), SceneObject(s2, color, x2, y + rng.uniform(-0.03, 0.03), w2),
+                  SceneObject(s3, other, rng.uniform(0.25, 0.75), 0.8, w3)), None)
+
+
+def exact_scenes(n: int, style: str, size: int = 256, seed: int = 0, progress: bool = True,
+                 touching: bool = False, on_object_share: float = 0.0) -> dict:
     """The share of scenes parsed exactly from pictures drawn in another style
     (`vccjax.vision.drawings`): every object found (shape, colour, centre within tau),
-    no phantom object, and the pointer found (within tau) exactly when there is one."""
+    no phantom object, and the pointer found (within tau) exactly when there is one.
+    Half the scenes have a pointer; `on_object_share` of those have it on an object (as
+    the examples of `attend_pointer` concepts do), the others keep it clear. With `touching`, every scene holds two
+    objects of one colour that touch (`touching_pair`), in any style."""
     from tqdm import tqdm
 
     from vccjax.vision.drawings import draw
 
+    from vccjax.vision.render import STYLES as RENDERED, render
+
     tau = DEFAULT_CONFIG.tau
-    rng = np.random.default_rng([seed, 7, size])
+    rng = np.random.default_rng([seed, 7, size, int(touching)])
     exact = 0
     misses: dict[str, int] = {}
     for _ in tqdm(range(n), desc=f"{style} {size}px", disable=not progress):
-        sc = random_scene(rng, (2, 8), widths=(0.04, 0.20), pointer=bool(rng.random() < 0.5))
-        img = draw(sc, style, size, seed=int(rng.integers(2**31)))
+        pointer, on_object = rng.random() < 0.5, rng.random() < on_object_share
+        if touching:
+            sc = touching_pair(rng)
+        else:
+            sc = random_scene(rng, (2, 8), widths=(0.04, 0.20), pointer=bool(pointer),
+                              pointer_on_object=bool(on_object))
+        picture_seed = int(rng.integers(2**31))
+        img = render(sc, size, style, picture_seed) if style in RENDERED else draw(sc, style, size, seed=picture_seed)
         try:
             parsed = parse_image(img)
         except SceneError as e:
@@ -146,5 +177,6 @@ def exact_scenes(n: int, style: str, size: int = 256, seed: int = 0, progress: b
             misses[why] = misses.get(why, 0) + 1
         else:
             exact += 1
-    return {"style": style, "size": size, "scenes": n, "exact": exact, "exact_share": round(exact / n, 4),
+    return {"style": style, "size": size, "touching": touching, "pointer_on_object_share": on_object_share,
+            "scenes": n, "exact": exact, "exact_share": round(exact / n, 4),
             "misses": dict(sorted(misses.items(), key=lambda kv: -kv[1]))}
