@@ -121,3 +121,17 @@ def test_two_touching_objects_of_one_colour_are_two_objects(style):
         img = render(sc, 256, style, seed=k) if style == "schematic" else draw(sc, style, 256, seed=k)
         got = parse_image(img)
         assert scenes_match(got, sc, CFG.tau), (style, s1, s2, got)
+
+
+def test_the_touching_measure_draws_two_objects_of_one_colour_that_touch():
+    from vccjax.vision.measure import exact_scenes, touching_pair
+
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        a, b, c = touching_pair(rng).objects
+        assert a.color == b.color != c.color
+        half = [o.width / 2 if o.shape == "circle" else
+                float(shape_polygon(o.shape, 0.0, 0.0, o.width, 1.0)[:, 0].max()) for o in (a, b)]
+        assert 0 <= (b.x - a.x) - sum(half) <= 0.5 / CFG.units
+    r = exact_scenes(4, "outline", 256, progress=False, touching=True)
+    assert r["touching"] and r["scenes"] == 4 and 0 <= r["exact"] <= 4

@@ -118,8 +118,8 @@ def end_to_end(
 
 
 def touching_pair(rng: np.random.Generator) -> Scene:
-    """Two objects of one colour side by side, touching (their boxes meet, up to half a
-    machine pixel apart), and a third of another colour elsewhere."""
+    """Two objects of one colour side by side, touching (their shapes' widest points up
+    to half a machine unit apart), and a third of another colour elsewhere."""
     from vccjax.machine.geometry import shape_polygon
     from vccjax.machine.instructions import COLORS, SHAPES
 
@@ -141,13 +141,13 @@ def exact_scenes(n: int, style: str, size: int = 256, seed: int = 0, progress: b
     (`vccjax.vision.drawings`): every object found (shape, colour, centre within tau),
     no phantom object, and the pointer found (within tau) exactly when there is one.
     Half the scenes have a pointer; `on_object_share` of those have it on an object (as
-    the examples of `attend_pointer` concepts do), the others keep it clear. With `touching`, every scene holds two
-    objects of one colour that touch (`touching_pair`), in any style."""
+    the examples of `attend_pointer` concepts do), the others keep it clear. With
+    `touching`, every scene holds two objects of one colour that touch (`touching_pair`);
+    our renderer's styles are drawn by `render`."""
     from tqdm import tqdm
 
     from vccjax.vision.drawings import draw
-
-    from vccjax.vision.render import STYLES as RENDERED, render
+    from vccjax.vision.render import STYLES as RENDERED
 
     tau = DEFAULT_CONFIG.tau
     rng = np.random.default_rng([seed, 7, size, int(touching)])
