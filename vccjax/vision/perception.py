@@ -180,7 +180,7 @@ def _grown(seed: np.ndarray, faint: np.ndarray, dark: np.ndarray, reach: int) ->
 
 def _luma_points(shaped: np.ndarray, core: np.ndarray, luma: np.ndarray, others: np.ndarray,
                  reach: int) -> np.ndarray:
-    """`shaped` grown into the connected pixels darker than the table around it by 40% of
+    """`shaped` grown into the connected pixels darker than the table around it by 45% of
     the core's contrast (a little under half, so a small square's soft corners stay).
     JPEG keeps brightness at full resolution but colour at half, so a small star's
     blurred points still show in brightness when their colour is gone. Pixels nearer
@@ -196,7 +196,7 @@ def _luma_points(shaped: np.ndarray, core: np.ndarray, luma: np.ndarray, others:
     bg, body = float(np.median(table)), float(np.median(luma[core]))
     if bg - body < 24:
         return shaped  # too little contrast in brightness to follow
-    ink = (luma[y0:y1, x0:x1] <= bg - 0.4 * (bg - body)) & ~others[y0:y1, x0:x1]
+    ink = (luma[y0:y1, x0:x1] <= bg - 0.45 * (bg - body)) & ~others[y0:y1, x0:x1]
     out = shaped.copy()
     start = shaped[y0:y1, x0:x1] & ink
     if not start.any():
