@@ -16,6 +16,7 @@ user would; never by the search.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import hashlib
 import json
 import time
@@ -66,7 +67,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     from vccjax import runtime
     from vccjax.machine.config import DEFAULT_CONFIG
     from vccjax.world.concepts import read_programs
-    from vccjax.world.dataset import build_dataset, Dataset
+    from vccjax.world.dataset import build_dataset, Dataset, rival_warnings
 
     examples = sorted({int(k) for k in a.examples.split(",")}, reverse=True)
     if not examples or min(examples) < 1 or max(examples) > 10:
@@ -75,9 +76,8 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     runtime.prepare()
     run = Path(a.run)
     data = Path(a.dataset) if a.dataset else run / "examples"
-    built = build_dataset(data, seed=0, programs=programs, progress=not a.quiet)
-    for c, why in built["rivals_left"].items():
-        print(f"warning: {c}: no training pair tells its program from: {'; '.join(why)}")
+    for line in rival_warnings(build_dataset(data, seed=0, programs=programs, progress=not a.quiet)):
+        print(line)
     ds = Dataset(data)
     failed = [c for c in programs if c not in ds.manifest["concepts"]]
     if failed:
@@ -85,8 +85,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     names = list(programs)
     asking = LearnSettings(budget=a.budget)
     meta = {"budget": a.budget, "examples": examples, "ask_examples": a.ask_examples,
-            "rivals": {"margin_nats": asking.rival_margin_nats, "budget": asking.rival_budget,
-                       "keep": asking.max_rivals, "fresh_scenes": asking.fresh_scenes, "min_scenes": asking.min_scenes},
+            "ask_settings": dataclasses.asdict(asking),
             "programs_sha256": hashlib.sha256(Path(a.programs).read_bytes()).hexdigest(),
             "examples_sha256": {c: ds.sha256(c) for c in names}}
     records = _open_run(run, meta)

@@ -130,7 +130,7 @@ def cmd_dataset_build(a: argparse.Namespace) -> int:
     import time
 
     from vccjax.world.concepts import read_programs
-    from vccjax.world.dataset import build_dataset
+    from vccjax.world.dataset import build_dataset, rival_warnings
 
     concepts = None if a.concepts in (None, "all") else [c.strip() for c in a.concepts.split(",") if c.strip()]
     programs = read_programs(a.programs) if a.programs else None
@@ -141,9 +141,7 @@ def cmd_dataset_build(a: argparse.Namespace) -> int:
     print(f"training pairs tell every rival of the reference apart in {len(m['concepts']) - len(left)} concepts;"
           f" {len(left)} leave some untold (manifest.json: rivals_left)")
     if programs is not None:
-        for name, why in left.items():
-            print(f"warning: {name}: no training pair tells its program from: {'; '.join(why)} "
-                  "(an instruction that changes no example is often a slip in the program)")
+        print("\n".join(rival_warnings(m)))
     for name, why in m["failed"].items():
         print(f"not built: {name}: {why}")
     return 1 if m["failed"] else 0

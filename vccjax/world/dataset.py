@@ -222,6 +222,14 @@ def build_dataset(
     return manifest
 
 
+def rival_warnings(manifest: dict) -> list[str]:
+    """One line per concept whose training pairs leave a rival of its program untold: for
+    a user's own program, an instruction that changes no example is often a slip."""
+    return [f"warning: {name}: no training pair tells its program from: {'; '.join(why)} "
+            "(an instruction that changes no example is often a slip in the program)"
+            for name, why in manifest["rivals_left"].items()]
+
+
 def vars_of(spec) -> dict:
     return {"count": spec.count, "objects": list(spec.objects), "widths": list(spec.widths)}
 
