@@ -6,8 +6,9 @@ when the inputs have one); programs that give the same outcome on every fresh sc
 behave alike and count as one. The examples are ambiguous when a program that behaves
 unlike the first one found gives another output on a fresh scene where the first runs
 (on at least `min_scenes` of them, so a rare tie of distances is not an alarm). The
-question put back is the fresh scene whose outcomes differ the most: the user answers
-it by adding that input with the output they mean as one more pair.
+question put back is the fresh scene that sets the most behaviours against the first
+program's (`judge`): the user answers it by adding that input with the output they mean
+as one more pair.
 """
 
 from __future__ import annotations
@@ -126,10 +127,16 @@ def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int 
           nats: Sequence[float] | None = None) -> tuple[Verdict, list[Scene]]:
     """Group `candidates` (the first is the program learned; `nats`, their description
     lengths) by behaviour on fresh scenes like `inputs`, decide whether the examples are
-    ambiguous, and pick the query: the fresh scene (one the first program runs on) whose
-    answer is expected to leave the least probability on wrong candidates, that is with
-    the smallest sum over its outcome groups of the group's squared probability (each
-    behaviour weighted by exp(-description length)); ties go to fewer objects."""
+    ambiguous, and pick the query among the fresh scenes the first program runs on:
+    the one where the fewest behaviours agree with the first; then the one whose answer
+    is most likely to leave the right program as the cheapest survivor (the largest sum
+    over outcome groups of the group's most probable member, each behaviour weighted by
+    exp(-description length)); then fewer objects.
+
+    The first program is the one kept, so the question is about it first: if the answer
+    agrees with it, every behaviour that disagreed is ruled out at once; if not, the
+    first is. Weighting that step by description length would ask about the first's
+    nearest variants rather than about a rival that reads the pictures otherwise."""
     scenes = fresh_scenes(inputs, n_scenes, seed, cfg)
     tau = cfg.tau
     runs = [outcomes(p, scenes, cfg) for p in candidates]
@@ -140,16 +147,16 @@ def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int 
     first = runs[0]
     disagree = [sum(1 for j, o in enumerate(first) if o is not None and not same(o, runs[k][j], tau)) for k in kept]
     ambiguous = any(d >= min_scenes for d in disagree[1:])
-    dl = np.array([nats[k] if nats is not None else 0.0 for k in kept])
-    weight = np.exp(-(dl - dl.min()))
-    weight = weight / weight.sum()
+    weight = np.exp(-(np.asarray(nats, float) - min(nats))) if nats is not None else np.ones(len(candidates))
     query = None
     if ambiguous:
-        def left_after(j: int) -> tuple:
+        def rank(j: int) -> tuple:
             groups = groups_of([runs[k][j] for k in kept], tau)
-            return (sum(weight[g].sum() ** 2 for g in groups), len(scenes[j].objects), j)
+            with_first = next(len(g) for g in groups if 0 in g)
+            kept_right = sum(max(weight[kept[i]] for i in g) for g in groups)
+            return (with_first, -kept_right, len(scenes[j].objects), j)
 
         usable = [j for j in range(len(scenes)) if first[j] is not None]
-        query = min(usable, key=left_after)
+        query = min(usable, key=rank)
     outs = [runs[k][query] for k in kept] if query is not None else []
     return Verdict(kept, disagree, len(scenes), ambiguous, query, outs, groups_of(outs, tau) if outs else []), scenes

@@ -22,7 +22,7 @@ their requests together (`search.lockstep`).
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Generator
+from collections.abc import Callable, Generator, Hashable
 from typing import NamedTuple
 
 import numpy as np
@@ -63,11 +63,18 @@ class Alternatives(NamedTuple):
     about): at most `keep`, the cheapest, costing at most `margin_bins` more than the
     best, found within `extra_programs` programs judged after the first fit. The best
     program is the one the plain search finds: the extra search only keeps the cutoff
-    higher for a while, and a program replaces the best only when strictly cheaper."""
+    higher for a while, and a program replaces the best only when strictly cheaper.
+
+    `behaviour`, when given, maps a fit's portions to a key of what it does (its outputs
+    on a few probe scenes): fits with one key count as one, the cheapest kept, and those
+    that behave like the best are not kept at all. Without it, cheap variants that do the
+    same thing (a useless `fixate` in front) fill the `keep` places and cut the search
+    short of a rival that does something else."""
 
     margin_bins: int
     keep: int
     extra_programs: int
+    behaviour: Callable[[np.ndarray], Hashable] | None = None
 
 
 class _Budget:
@@ -79,9 +86,9 @@ class _Budget:
         self.quota = budget - cheaper  # programs of cost exactly b* still allowed
         self.cutoff = self.b_star  # the most a program may cost (bins)
         self.programs = 0  # complete programs counted
-        self.best: tuple[int, np.ndarray] | None = None
+        self.best: tuple[int, np.ndarray, Hashable] | None = None  # (cost, path, behaviour or None)
         self.alternatives = alternatives
-        self.fits: list[tuple[int, np.ndarray]] = []  # every fit, kept only with alternatives
+        self.fits: list[tuple[int, np.ndarray, Hashable]] = []  # every fit, kept only with alternatives
         self.extra_left = alternatives.extra_programs if alternatives else 0
 
     def counts_program(self, cost: int) -> bool:
@@ -102,13 +109,17 @@ class _Budget:
 
     def found(self, cost: int, path: np.ndarray) -> None:
         """A program that explains every example: keep it if it is the cheapest so far."""
-        fit = (cost, path.copy())
+        alt = self.alternatives
+        key = alt.behaviour(path) if alt is not None and alt.behaviour is not None else None
+        fit = (cost, path.copy(), key)
         if self.best is None or cost < self.best[0]:
             self.best = fit
-        alt = self.alternatives
         if alt is not None:  # the `keep` cheapest within the margin (stable: ties in finding order)
-            within = [f for f in [*self.fits, fit] if f[0] <= self.best[0] + alt.margin_bins]
-            self.fits = sorted(within, key=lambda f: f[0])[: alt.keep]
+            within = sorted((f for f in [*self.fits, fit] if f[0] <= self.best[0] + alt.margin_bins),
+                            key=lambda f: f[0])
+            if alt.behaviour is not None:
+                within = _one_per_behaviour(self.best, within)
+            self.fits = within[: alt.keep]
         self.cutoff = min(self.cutoff, self._limit())
 
     def _limit(self) -> int:
@@ -126,7 +137,17 @@ class _Budget:
         """The alternatives kept, cheapest first (ties in finding order), the best excluded."""
         if self.best is None or self.alternatives is None:
             return ()
-        return tuple(f for f in self.fits if f is not self.best)[: max(self.alternatives.keep - 1, 0)]
+        return tuple(f[:2] for f in self.fits if f is not self.best)[: max(self.alternatives.keep - 1, 0)]
+
+
+def _one_per_behaviour(best: tuple, fits: list[tuple]) -> list[tuple]:
+    """The best, and the cheapest of `fits` (cheapest first) for each other behaviour."""
+    seen, kept = {best[2]}, [best]
+    for f in fits:
+        if f[2] not in seen:
+            seen.add(f[2])
+            kept.append(f)
+    return sorted(kept, key=lambda f: f[0])
 
 
 def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chunk: int, slice_size: int,
@@ -170,7 +191,8 @@ def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chun
                 if len(part):
                     frames.append(_Frame(backend.take(reply.states, part), tokens[part], syntax[part], cost[part],
                                          paths[part], frame.depth + 1))
-    return Outcome(limits.best, nodes, limits.programs, limits.b_star, limits.counts, limits.kept())
+    best = limits.best[:2] if limits.best else None
+    return Outcome(best, nodes, limits.programs, limits.b_star, limits.counts, limits.kept())
 
 
 def _children(chain: Chain, frame: _Frame, cutoff: int) -> _Children:

@@ -17,13 +17,15 @@ import dataclasses
 import math
 from collections.abc import Callable, Sequence
 
-from search.ambiguity import Verdict, judge
+import numpy as np
+
+from search.ambiguity import Verdict, fresh_scenes, judge, outcomes
 from search.arguments import argument_logp
 from search.chain import Chain
 from search.dfs import Alternatives
 from search.explore import Searcher
 from search.model import MarkovModel, Vocabulary
-from search.result import Alternative, Result
+from search.result import Alternative, Result, program_of
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.machine.program import Program
@@ -40,7 +42,8 @@ class LearnSettings:
     library: str = "shipped"  # "shipped", "uniform" (from scratch) or a library file
     rival_margin_nats: float = 6.0  # rivals at most this much less probable than the first
     rival_budget: int = 2_000_000  # programs ranked past the first fit that the rival pass judges
-    max_rivals: int = 32
+    max_rivals: int = 32  # distinct behaviours on the probe scenes
+    rival_probes: int = 16  # fresh scenes that tell the rival search's behaviours apart
     fresh_scenes: int = 100
     min_scenes: int = 2  # fresh scenes a rival must part on to make the examples ambiguous
     seed: int = 0
@@ -51,7 +54,7 @@ class LearnSettings:
             raise ValueError(f"--args must be predicted or uniform, got {self.args!r}")
         if self.budget < 1:
             raise ValueError(f"--budget must be positive, got {self.budget}")
-        if self.rival_budget < 0 or self.max_rivals < 1 or self.rival_margin_nats < 0:
+        if self.rival_budget < 0 or self.max_rivals < 1 or self.rival_margin_nats < 0 or self.rival_probes < 0:
             raise ValueError("the rival search's budget, margin and count must not be negative")
         if self.fresh_scenes < 1:
             raise ValueError(f"--fresh-scenes must be positive, got {self.fresh_scenes}")
@@ -119,24 +122,35 @@ def chain_for(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings,
     return Chain(vocab, model, argument_logp(mode, pairs, None, settings.fixate, fallback=True), settings.delta), name
 
 
-def alternatives_for(chain: Chain, settings: LearnSettings, budget: int) -> Alternatives:
+def alternatives_for(chain: Chain, settings: LearnSettings, budget: int,
+                     inputs: Sequence[Scene] = ()) -> Alternatives:
+    """The rival search's settings; with `inputs`, rivals are told apart by what they do
+    on `rival_probes` fresh scenes like them, so that `max_rivals` counts behaviours."""
     margin = int(math.ceil(settings.rival_margin_nats / chain.delta))
-    return Alternatives(margin, settings.max_rivals, budget)
+    behaviour = None
+    if inputs and settings.rival_probes:
+        probes = fresh_scenes(inputs, settings.rival_probes, settings.seed, DEFAULT_CONFIG)
+
+        def behaviour(path: np.ndarray) -> tuple:
+            return tuple(outcomes(program_of(chain, [int(x) for x in path if x >= 0]), probes, DEFAULT_CONFIG))
+    return Alternatives(margin, settings.max_rivals, budget, behaviour)
 
 
 def with_rivals(first: Result, chain: Chain, task: Task, settings: LearnSettings, searcher: Searcher,
-                progress: Callable[[int], None] | None = None) -> Result:
+                progress: Callable[[int], None] | None = None, inputs: Sequence[Scene] = ()) -> Result:
     """`first` (a finished search's result) with the rivals of a second pass over the
     programs ranked up to `first.rank + rival_budget`, within the margin of the first.
 
     The depth-first search prunes by its cutoff as it goes, so a cutoff raised after the
     first fit would miss programs in branches already cut: the pass starts over with the
     higher cutoff. The first program stays the answer (the pass finds it again, or one of
-    the same cost, which then counts as a rival)."""
+    the same cost, which then counts as a rival). With the examples' `inputs`, rivals are
+    kept one per behaviour (`alternatives_for`)."""
     if not first.found or settings.rival_budget == 0:
         return first
     budget = first.rank + settings.rival_budget
-    again = searcher.search(chain, task, budget, progress, alternatives_for(chain, settings, budget))
+    alternatives = alternatives_for(chain, settings, budget, inputs)
+    again = searcher.search(chain, task, budget, progress, alternatives)
     others = [Alternative(again.program, again.text, again.dl_nats)] if again.found else []
     others += list(again.alternatives)
     kept = tuple(a for a in others if a.program != first.program)[: settings.max_rivals - 1]
@@ -167,6 +181,6 @@ def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searche
         searcher = Explorer(width=1)
     task = Task.from_pairs(pairs)
     result = with_rivals(searcher.search(chain, task, settings.budget, progress), chain, task, settings, searcher,
-                         progress)
+                         progress, [a for a, _ in pairs])
     verdict, scenes = verdict_for(result, pairs, settings)
     return Learned(result, name, verdict, scenes)

@@ -132,3 +132,40 @@ def test_the_rival_pass_looks_past_the_budgets_cutoff(chain, two_pairs):
     kept = sorted(a.program.text() for a in r.alternatives)
     assert kept and kept == sorted(brute - {first.program.text()})  # every rival, all beyond the first's cutoff
     assert (r.text, r.rank, r.dl_bins) == (first.text, first.rank, first.dl_bins) and r.programs > first.programs
+
+
+def test_rivals_are_kept_one_per_behaviour_the_cheapest_of_each(chain, two_pairs):
+    """With a behaviour key, `keep` counts behaviours: for each behaviour but the best's,
+    the cheapest fit within the margin (brute force), and nothing that acts like the best."""
+    from search.ambiguity import fresh_scenes, outcomes
+    from search.result import program_of
+
+    task = Task.from_pairs(two_pairs)
+    lp = dict(chain.arg_logp)
+    lp[OP["set_color_attn"]] = uniform_over(range(len(lp[OP["set_color_attn"]])), "set_color_attn")
+    chain = Chain(chain.vocab, chain.model, lp)  # colours too: more ways to pick an object
+    probes = fresh_scenes([a for a, _ in two_pairs], 8, seed=3)
+
+    def key_of(program: Program) -> tuple:
+        return tuple(outcomes(program, probes))
+
+    def behaviour(path) -> tuple:
+        return key_of(program_of(chain, [int(x) for x in path if x >= 0]))
+
+    margin = 300
+    r = ScalarExplorer().search(chain, task, BUDGET, alternatives=Alternatives(margin, 10_000, 10**6, behaviour))
+    brute = sorted(((c, p) for p, c in _every_program_up_to(chain, r.dl_bins + margin) if _explains(p, two_pairs)),
+                   key=lambda cp: cp[0])
+    cheapest: dict[tuple, int] = {}
+    for c, p in brute:
+        cheapest.setdefault(key_of(p), c)
+    best_key = key_of(r.program)
+    expected = sorted(c for k, c in cheapest.items() if k != best_key)
+    keys = [key_of(a.program) for a in r.alternatives]
+    assert len(expected) >= 2 and len(set(keys)) == len(keys) and best_key not in keys
+    assert sorted(cheapest[k] for k in keys) == expected  # every other behaviour once
+    cost = {p.text(): c for c, p in brute}
+    assert [cost[a.program.text()] for a in r.alternatives] == [cheapest[k] for k in keys]  # its cheapest
+    # a small `keep` is filled by distinct behaviours, so it reaches past the same-acting variants
+    few = ScalarExplorer().search(chain, task, BUDGET, alternatives=Alternatives(margin, 3, 10**6, behaviour))
+    assert [key_of(a.program) for a in few.alternatives] == keys[:2]
