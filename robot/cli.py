@@ -20,7 +20,7 @@ def _program(a: argparse.Namespace):
     if a.program:
         program = runtime.program_from_arg(a.program)
     else:
-        from robot.suite import programs_of
+        from robot.sources import programs_of
 
         program = programs_of(a.concept, a.induced)
     for p in program if isinstance(program, list) else [program]:
@@ -74,23 +74,69 @@ def _setup_mjx(a: argparse.Namespace) -> None:
     runtime.prepare(xla_flags=[XLA_FLAG], cores=None if a.all_cores else 1)
 
 
+def _suite_programs(a: argparse.Namespace):
+    """The suite's programs and concepts, checked before MJX starts."""
+    from robot.choice import arm_able, default_choice, not_arm_able
+    from robot.sources import Programs, RUN_OF_RECORD
+    from robot.suite import TEN
+
+    programs = Programs(a.source or str(RUN_OF_RECORD))
+    # the choice is of induced concepts: the run's own, or for the reference programs (the
+    # comparison) the run of record's, so that both suites run the same concepts
+    induced = {"run": programs, "reference": None, "library": programs}[programs.source.kind]
+    if a.concepts:
+        names = list(TEN) if a.concepts == "ten" else [c.strip() for c in a.concepts.split(",") if c.strip()]
+        for name in names:
+            why = not_arm_able(programs.of(name))  # an unknown name is refused here too
+            if why:
+                raise ValueError(f"--concepts {name}: its program {why}, not something an arm can do")
+    else:
+        table = (induced or Programs(str(RUN_OF_RECORD))).table
+        names = sorted(arm_able(table)) if a.all or programs.source.kind == "library" else \
+            default_choice(table, a.count, a.seed)
+        names = [c for c in names if c in programs and not not_arm_able(programs.of(c))]
+    if not names:
+        raise ValueError(f"--source {programs.source.path or programs.source.kind}: no concept an arm can carry out")
+    return programs, names
+
+
+def _shard(text: str) -> tuple[int, int]:
+    try:
+        k, n = (int(x) for x in text.split("/"))
+    except ValueError:
+        raise ValueError(f"--shard {text}: give K/N, as 0/2") from None
+    if not 0 <= k < n:
+        raise ValueError(f"--shard {text}: K must be in 0..N-1")
+    return k, n
+
+
 def cmd_suite(a: argparse.Namespace) -> int:
+    if a.scenarios < 1 or a.count < 1:
+        raise ValueError("--scenarios and --count must be positive")
+    shard = _shard(a.shard)
+    programs, names = _suite_programs(a)  # bad input ends here, before JAX and MuJoCo start
     _setup_mjx(a)
     from robot.suite import run_suite
 
-    s = run_suite(a.out, a.scenarios, a.seed, induced=a.induced)
-    for name, rate in s["per_concept"].items():
-        print(f"{rate:7.1%}  {name}")
+    print(f"{len(names)} concepts from {programs.source.kind} {programs.source.path or ''}, "
+          f"{a.scenarios} scenarios each" + (f", shard {a.shard}" if a.shard != "0/1" else ""))
+    s = run_suite(a.out, programs, names, a.scenarios, a.seed, shard=shard)
     print("failures: " + (", ".join(f"{c} {n}" for c, n in s["failures"].items()) or "none"))
-    print(f"success: {s['success']} of {s['rollouts']} ({s['success'] / max(1, s['rollouts']):.1%})")
+    p = s["parse"]
+    print(f"parse: {p['objects_exact']} of {p['objects']} objects exact, {p['scenes_exact']} of {p['scenes']} scenes")
+    print(f"success: {s['success']} of {s['rollouts']} ({s['success'] / max(1, s['rollouts']):.1%}), "
+          f"{s['concepts']} of {s['of']} concepts recorded")
     return 0
 
 
 def cmd_stress(a: argparse.Namespace) -> int:
+    from robot.sources import Programs, RUN_OF_RECORD
+
+    programs = Programs(a.source or str(RUN_OF_RECORD))
     _setup_mjx(a)
     from robot.stress import run_stress
 
-    s = run_stress(a.out, a.rollouts, a.seed)
+    s = run_stress(a.out, programs, a.rollouts, a.seed)
     print(f"{s['rollouts']} rollouts of {s['concepts']} concepts: {s['rolled_out']} rolled out, "
           f"{s['success']} carried out, wall {s['wall_s']:.0f} s")
     print("failures: " + (", ".join(f"{c} {n}" for c, n in s["failures"].items()) or "none"))
@@ -119,12 +165,22 @@ def add_commands(sub) -> None:
                    help="let XLA use every core (on a 2-core CPU this hung at 32 scenarios)")
     r.set_defaults(fn=cmd_run)
 
-    u = s.add_parser("suite", help="the ten-concept benchmark, resumable (one JSON per concept)")
+    u = s.add_parser("suite", help="learned concepts on the arm, judged against the true scene (resumable)",
+                     description="Carry out concepts from their learned programs (default: those the run of "
+                                 "record induced) in randomized scenarios; one JSON per concept with a record per "
+                                 "scenario. Default choice: 150 arm-able concepts stratified by program length "
+                                 "(docs/robot.md).")
     u.add_argument("--out", required=True, help="results folder (an existing one is resumed)")
-    u.add_argument("--induced", metavar="RUN",
-                   help="the programs a `vcc induce` run found (its folder) instead of the reference ones")
-    u.add_argument("--scenarios", type=int, default=32)
+    u.add_argument("--source", metavar="RUN|reference|library",
+                   help="where programs come from: a `vcc induce` run folder (default: the run of record), "
+                        "the shipped reference programs, or the user's library of learned concepts")
+    u.add_argument("--concepts", help="comma-separated names (A+B composes), or 'ten' for the first ten-concept suite")
+    u.add_argument("--all", action="store_true", help="every arm-able concept of the source")
+    u.add_argument("--count", type=int, default=150, help="concepts in the default stratified choice (150)")
+    u.add_argument("--scenarios", type=int, default=8, help="randomized scenarios per concept (default 8)")
     u.add_argument("--seed", type=int, default=0)
+    u.add_argument("--shard", default="0/1", metavar="K/N",
+                   help="run only every N-th concept from the K-th: N processes on one folder, one core each")
     u.add_argument("--all-cores", action="store_true", help="let XLA use every core")
     u.set_defaults(fn=cmd_suite)
 
@@ -132,5 +188,7 @@ def add_commands(sub) -> None:
     t.add_argument("--out", required=True, help="results folder (an existing one is resumed)")
     t.add_argument("--rollouts", type=int, default=1000, help="rollouts, in whole batches of 32 (default 1000)")
     t.add_argument("--seed", type=int, default=7)
+    t.add_argument("--source", metavar="RUN|reference|library",
+                   help="where programs come from (default: the run of record's learned programs)")
     t.add_argument("--all-cores", action="store_true", help="let XLA use every core")
     t.set_defaults(fn=cmd_stress)

@@ -2,8 +2,12 @@
 
 Success: every object's final position on the table is within `TOLERANCE` of where the
 VCC's output puts it (through the workspace-to-table mapping), nothing fell off the
-table, and at the end the gripper is open and clear of every object. A failure is put
-down to the first cause that holds, in this order: parse error, plan error, IK
+table, and at the end the gripper is open and clear of every object. The VCC's output
+is computed on the parsed scene, and the parse is first checked against the scene truly
+on the table (`robot.truth`): every true object seen once, shape, colour and centre
+right, so each true object's goal is known. A failure is put down to the first cause
+that holds, in this order: no scenario (none of the arm's bodies can stage the concept),
+parse error (nothing could be parsed), parse wrong, plan error, IK
 unreachable (the tool never got within 2 cm of a target), object fell off the table,
 grasp slipped (a carried object was never lifted, or lagged the tool by 2 cm while
 carried), object dropped (lifted, then fell before its place), gripper not clear,
@@ -21,7 +25,7 @@ from robot.control import RECORD, TICK
 from robot.world import BODIES, on_table, to_table
 
 TOLERANCE = 0.02
-CAUSES = ("parse error", "plan error", "IK unreachable", "fell off the table", "grasp slipped", "object dropped",
+CAUSES = ("no scenario", "parse error", "parse wrong", "plan error", "IK unreachable", "fell off the table", "grasp slipped", "object dropped",
           "gripper not clear", "misplaced")
 
 
@@ -32,6 +36,7 @@ class Verdict:
     detail: str
     max_error_m: float  # largest final distance of an object from its VCC place (nan if not run)
     seed: int
+    parse: dict | None = None  # the parse against the truth (`robot.truth.ParseCheck.record`), when parsed
 
 
 def _slot_xyz(model: mujoco.MjModel, q: np.ndarray) -> np.ndarray:
@@ -51,17 +56,20 @@ def _tcp(model: mujoco.MjModel, qs: np.ndarray) -> np.ndarray:
 
 
 def judge(model: mujoco.MjModel, prepared, qs: np.ndarray | None) -> Verdict:
+    """The verdict on one prepared scenario, with its parse's record."""
+    v = _verdict(model, prepared, qs)
+    return dataclasses.replace(v, parse=prepared.check.record() if prepared.check is not None else None)
+
+
+def _verdict(model: mujoco.MjModel, prepared, qs: np.ndarray | None) -> Verdict:
     seed = prepared.scenario.seed
     if prepared.error is not None:
         cause = prepared.error.split(":")[0]
         return Verdict(False, cause, prepared.error, float("nan"), seed)
-    sc, parsed, expected = prepared.scenario, prepared.parsed, prepared.expected
-    truth = sc.scene.objects
-    # each parsed object is the true object nearest it (parsing was checked to be close)
-    slot_of = []
-    for o in parsed.objects:
-        j = min(range(len(truth)), key=lambda j: (truth[j].x - o.x) ** 2 + (truth[j].y - o.y) ** 2)
-        slot_of.append(sc.slots[j])
+    sc, expected = prepared.scenario, prepared.expected
+    # each parsed object is the true object it was matched to (the parse was checked exact,
+    # so every true object has one), and its goal is the program's output for it
+    slot_of = [sc.slots[j] for j in prepared.check.match]
     xyz = _slot_xyz(model, qs)  # (T, slots, 3)
     final = xyz[-1]
     goal = np.array([to_table(o.x, o.y) for o in expected.objects])

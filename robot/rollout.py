@@ -23,6 +23,7 @@ from robot.mjcf import scene_xml
 from robot.motion import keyframes
 from robot.plan import PickPlace, PlanError, plan
 from robot.scenario import Scenario, draw
+from robot.truth import ParseCheck, check_parse
 from vccjax.errors import SceneError
 from vccjax.machine.program import Program
 from vccjax.machine.scene import Scene
@@ -37,8 +38,9 @@ class Prepared:
     expected: Scene | None  # the VCC's output on the parsed scene
     keyframes: Keyframes | None
     ticks: int
-    error: str | None  # "parse error: ..." or "plan error: ..."
+    error: str | None  # "parse error: ...", "parse wrong: ..." or "plan error: ..."
     windows: list[tuple[int, int]] = dataclasses.field(default_factory=list)  # per move: ticks held aloft
+    check: ParseCheck | None = None  # the parse against the true scene
 
 
 class Bench:
@@ -68,12 +70,17 @@ class Bench:
             parsed, _ = self.camera.scene(d)
         except SceneError as e:
             return Prepared(scenario, None, [], None, None, 0, f"parse error: {e}")
+        check = check_parse(scenario.scene, parsed)
+        if not check.exact:  # the arm would act on a scene that is not on the table
+            return Prepared(scenario, parsed, [], None, None, 0, f"parse wrong: {check.problem()}", check=check)
         try:
             moves, expected = plan(program, parsed)
+            if [o.color for o in expected.objects] != [o.color for o in parsed.objects]:
+                raise PlanError("the program changes a colour, which the arm cannot")
             kf, ticks, windows = keyframes(moves, start, start_yaw)
         except (PlanError, ValueError) as e:
-            return Prepared(scenario, parsed, [], None, None, 0, f"plan error: {e}")
-        return Prepared(scenario, parsed, moves, expected, kf, ticks, None, windows)
+            return Prepared(scenario, parsed, [], None, None, 0, f"plan error: {e}", check=check)
+        return Prepared(scenario, parsed, moves, expected, kf, ticks, None, windows, check)
 
     def run(self, program: Program | list[Program], scenarios: list[Scenario], keep: bool = False
             ) -> tuple[list[Verdict], dict, list[np.ndarray | None]]:

@@ -142,20 +142,3 @@ def _distractors(rng: np.random.Generator) -> tuple[tuple[float, float, float], 
         x, y = {0: (0.45 + along, 0.27), 1: (0.45 + along, -0.27), 2: (0.72, along)}[int(side)]
         out.append((float(x), float(y) + 0.01 * k, float(rng.uniform(0, np.pi))))
     return tuple(out)
-
-
-def arm_concepts() -> list[str]:
-    """Concepts whose reference program an arm can carry out: it grabs something, and
-    neither recolours nor removes objects nor imagines them."""
-    from vccjax.world.concepts import concept_names, reference_program
-    from vccjax.machine.instructions import NAMES
-
-    from robot.plan import NOT_ON_A_ROBOT
-
-    banned = {*NOT_ON_A_ROBOT, "imagine_object", "reset_imagination"}  # imagined objects block carries
-    out = []
-    for name in concept_names():
-        used = {NAMES[op] for op in reference_program(name).ops}
-        if "grab_object" in used and not used & banned:
-            out.append(name)
-    return out

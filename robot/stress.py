@@ -1,5 +1,6 @@
-"""The arm's robustness run: many rollouts of random arm-compatible concepts on random
-scenarios, 32 at a time on MJX, each checked for non-finite state and judged. One JSON
+"""The arm's robustness run: many rollouts of random arm-able concepts (their learned
+programs, by default those of the run of record: `robot.sources`) on random scenarios,
+32 at a time on MJX, each checked for non-finite state and judged. One JSON
 per batch, written when the batch finishes, so an interrupted run resumes where it
 stopped; each batch is drawn from its own seed, so a resumed run is the same run."""
 
@@ -12,22 +13,24 @@ from pathlib import Path
 
 import numpy as np
 
+from robot.sources import Programs
+
 BATCH = 32
 
 
-def draw_batch(seed: int, batch: int, size: int = BATCH) -> list:
-    """`size` (program, scenario) pairs: concepts drawn uniformly from the arm's concepts,
-    a concept that no scenario of the arm's bodies lets run is drawn again."""
-    from robot.scenario import arm_concepts, draw
-    from vccjax.world.concepts import reference_program
+def draw_batch(seed: int, batch: int, programs: Programs, size: int = BATCH) -> list:
+    """`size` (name, program, scenario) triples: concepts drawn uniformly from the arm-able
+    ones of `programs`; a concept that no scenario of the arm's bodies lets run is drawn again."""
+    from robot.choice import arm_able
+    from robot.scenario import draw
     from vccjax.errors import SceneError
 
     rng = np.random.default_rng([seed, batch])
-    names = arm_concepts()
+    names = sorted(arm_able(programs.table))
     items = []
     while len(items) < size:
         name = names[int(rng.integers(len(names)))]
-        program = reference_program(name)
+        program = programs.table[name]
         try:
             items.append((name, program, draw(program, int(rng.integers(1 << 30)), max_tries=200)))
         except SceneError:
@@ -35,7 +38,7 @@ def draw_batch(seed: int, batch: int, size: int = BATCH) -> list:
     return items
 
 
-def run_stress(out: str | Path, rollouts: int = 1000, seed: int = 7, log=print) -> dict:
+def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: int = 7, log=print) -> dict:
     """Run (or resume) `rollouts` (rounded up to whole batches) into `out`; returns the
     summary, also written there as summary.json."""
     from tqdm import tqdm
@@ -50,15 +53,15 @@ def run_stress(out: str | Path, rollouts: int = 1000, seed: int = 7, log=print) 
     bench = None
     for b in tqdm(range(batches), desc="robot stress", unit="batch"):
         path = out / f"batch-{b:03d}.json"
-        if finished(path, seed=seed):
+        if finished(path, seed=seed, source=programs.source.label()):
             continue
         bench = bench or Bench()
-        items = draw_batch(seed, b)
+        items = draw_batch(seed, b, programs)
         start = time.perf_counter()
         verdicts, info, kept = bench.run_pairs([(p, s) for _, p, s in items], keep=True)
         info["wall_s"] = time.perf_counter() - start
         finite = [q is None or bool(np.isfinite(q).all()) for q in kept]
-        record = {"batch": b, "seed": seed, "timing": info,
+        record = {"batch": b, "seed": seed, "source": programs.source.label(), "timing": info,
                   "concepts": [n for n, _, _ in items], "scenario_seeds": [s.seed for _, _, s in items],
                   "rolled_out": sum(q is not None for q in kept), "non_finite": finite.count(False),
                   **tally(verdicts)}

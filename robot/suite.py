@@ -1,16 +1,26 @@
-"""The arm's benchmark: ten concepts (stacking, touching, the pointed location, a
-colour-filtered loop, a two-concept composition in the spirit of the paper's lemons and
-limes), each in the same number of randomized scenarios. One JSON file per concept,
-written when it finishes, so an interrupted run resumes where it stopped."""
+"""The arm's benchmark: concepts carried out from their *learned* programs (by default
+those of the run of record; `robot.sources`), each in the same number of randomized
+scenarios, judged against the scene truly on the table (`robot.judge`, `robot.truth`).
+
+One JSON file per concept, written when its batch finishes, holding one record per
+scenario (seed, verdict, parse check) and the program's source, text and hash; an
+interrupted run resumes where it stopped, and a record made with another program,
+source, seed or scenario count is redone, not mixed in. Scenarios of several concepts
+share one MJX batch. `shard` splits the concepts between processes that write into the
+same folder (each its own files), so that two single-core processes use two cores.
+"""
 
 from __future__ import annotations
 
 import json
 import time
 from collections import Counter
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
-SUITE: tuple[str, ...] = (
+from robot.sources import Programs, program_sha256
+
+TEN: tuple[str, ...] = (  # the first suite: stacking, touching, the pointer, a colour loop, a composition
     "stack_in_place_horizontal_left",
     "stack_object_upper_left_corner_vertically",
     "make_the_green_obj_touch_the_red_obj",
@@ -22,43 +32,11 @@ SUITE: tuple[str, ...] = (
     "move_green_to_right_bottom_corner",
     "move_all_yellow_left+move_green_to_right_bottom_corner",  # composition: yellow aside, the green one away
 )
+BATCH = 32  # scenarios rolled out at once (whole concepts)
 
 
-def induced_programs(run: str | Path) -> dict:
-    """{concept: Program} a `vcc induce` run found (its results.jsonl; a later record wins)."""
-    from vccjax.errors import DataFileError
-    from vccjax.machine.program import parse
-
-    path = Path(run) / "results.jsonl"
-    if not path.is_file():
-        raise DataFileError(f"{path}: missing (give the folder of a `vcc induce` run)")
-    found = {}
-    for k, line in enumerate(path.read_text().splitlines()):
-        try:
-            r = json.loads(line)
-            if r["found"]:
-                found[r["concept"]] = parse(r["program"])
-        except (ValueError, KeyError, TypeError) as e:
-            raise DataFileError(f"{path}: line {k + 1} is not a result of `vcc induce` ({e})") from None
-    return found
-
-
-def programs_of(name: str, induced: str | Path | None = None):
-    """A concept's program: the reference one (or, for a concept learned with `vcc learn
-    --save`, the program saved in the user's library), or the one a `vcc induce` run in
-    folder `induced` found; for A+B, A's then B's (run on the scene A leaves)."""
-    from vccjax.world.user_concepts import concept_program
-
-    parts = name.split("+")
-    if induced is None:  # a shipped concept's reference program, or one the user saved
-        programs = [concept_program(c) for c in parts]
-    else:
-        found = induced_programs(induced)
-        missing = [c for c in parts if c not in found]
-        if missing:
-            raise ValueError(f"{', '.join(missing)}: not induced in {induced}")
-        programs = [found[c] for c in parts]
-    return programs[0] if len(programs) == 1 else programs
+def file_of(out: Path, name: str) -> Path:
+    return out / f"{name.replace('<', '').replace('>', '').replace('+', '_then_')}.json"
 
 
 def finished(path: Path, **expected) -> bool:
@@ -77,38 +55,96 @@ def write_record(path: Path, record: dict) -> None:
     tmp.replace(path)
 
 
-def run_suite(out: str | Path, scenarios: int = 32, seed: int = 0, concepts=SUITE, log=print,
-              induced: str | Path | None = None) -> dict:
-    """Run (or resume) the suite into `out` (reference programs, or those of the `vcc
-    induce` run in folder `induced`); returns the summary (also written there)."""
+def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scenarios: int = 8, seed: int = 0,
+              log: Callable[[str], None] = print, shard: tuple[int, int] = (0, 1)) -> dict:
+    """Run (or resume) `concepts` (this shard's share) into `out`; returns the summary
+    of every concept of `concepts` recorded there (also written as summary.json)."""
     from tqdm import tqdm
 
-    from robot.judge import tally
-    from robot.rollout import Bench, scenarios_for
+    from robot.judge import Verdict
+    from robot.scenario import draw
+    from vccjax.errors import SceneError
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    source = programs.source.label()
+
+    def settings(name: str) -> dict:
+        return {"scenarios": scenarios, "seed": seed, "source": source,
+                "program_sha256": program_sha256(programs.of(name))}
+
+    mine = list(concepts)[shard[0]::shard[1]]
+    todo = [c for c in mine if not finished(file_of(out, c), **settings(c))]
     bench = None
-    for name in tqdm(concepts, desc="robot suite", unit="concept"):
-        path = out / f"{name.replace('<', '').replace('>', '').replace('+', '_then_')}.json"
-        source = "reference" if induced is None else f"induced: {induced}"
-        if finished(path, scenarios=scenarios, seed=seed, source=source):
-            continue
-        bench = bench or Bench()
-        programs = programs_of(name, induced)
+    bar = tqdm(total=len(todo), desc="robot suite", unit="concept")
+    while todo:
+        group, items, staged = [], [], {}
+        while todo and (not group or len(items) + scenarios <= BATCH):
+            name = todo.pop(0)
+            program = programs.of(name)
+            group.append(name)
+            for k in range(scenarios):
+                s = seed * 100_003 + k
+                try:
+                    items.append((name, program, draw(program, s)))
+                except SceneError as e:
+                    staged.setdefault(name, {})[s] = Verdict(False, "no scenario", str(e), float("nan"), s)
         start = time.perf_counter()
-        verdicts, info, _ = bench.run(programs, scenarios_for(programs, scenarios, seed))
+        verdicts, info = [], {}
+        if items:
+            if bench is None:
+                from robot.rollout import Bench
+
+                bench = Bench()
+            verdicts, info, _ = bench.run_pairs([(p, sc) for _, p, sc in items])
+        for (name, _, sc), v in zip(items, verdicts, strict=True):
+            staged.setdefault(name, {})[sc.seed] = v
         info["wall_s"] = time.perf_counter() - start
-        texts = [p.text() for p in (programs if isinstance(programs, list) else [programs])]
-        record = {"concept": name, "scenarios": scenarios, "seed": seed, "programs": texts,
-                  "source": source, "timing": info,
-                  **tally(verdicts)}
-        write_record(path, record)
-        log(f"{name}: {record['success']} of {scenarios}, wall {info['wall_s']:.0f} s")
-    rows = [json.loads(p.read_text()) for p in sorted(out.glob("*.json")) if p.name != "summary.json"]
-    total = sum(r["scenarios"] for r in rows)
-    summary = {"concepts": len(rows), "rollouts": total, "success": sum(r["success"] for r in rows),
-               "failures": dict(sum((Counter(r["failures"]) for r in rows), Counter())),
-               "per_concept": {r["concept"]: r["success"] / r["scenarios"] for r in rows}}
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+        for name in group:
+            runs = [staged[name][s] for s in sorted(staged[name])]
+            program = programs.of(name)
+            texts = [p.text() for p in (program if isinstance(program, list) else [program])]
+            record = {"concept": name, **settings(name), "programs": texts, "batch": {"concepts": group, **info},
+                      "success": sum(v.success for v in runs),
+                      "failures": dict(Counter(v.cause for v in runs if not v.success)),
+                      "records": [v.__dict__ for v in runs]}
+            write_record(file_of(out, name), record)
+            log(f"{name}: {record['success']} of {scenarios}")
+            bar.update(1)
+    bar.close()
+    return summarise(out, programs, concepts, scenarios, seed)
+
+
+def summarise(out: Path, programs: Programs, concepts: Sequence[str], scenarios: int, seed: int) -> dict:
+    """Successes, failures by cause, parse accuracy and per-concept rates over the
+    concepts recorded in `out` with these settings (summary.json)."""
+    rows = []
+    for name in concepts:
+        path = file_of(out, name)
+        if finished(path, scenarios=scenarios, seed=seed, source=programs.source.label(),
+                    program_sha256=program_sha256(programs.of(name))):
+            rows.append(json.loads(path.read_text()))
+    from robot.choice import STRATA, length, not_arm_able
+
+    records = [r for row in rows for r in row["records"]]
+    parsed = [r["parse"] for r in records if r.get("parse")]
+    strata = {}
+    for lo, hi in STRATA:
+        these = [row for row in rows if lo <= length(programs.of(row["concept"])) <= hi]
+        strata[f"{lo}-{hi}" if hi < 10**6 else f"{lo}+"] = {
+            "chosen": sum(lo <= length(programs.of(c)) <= hi for c in concepts), "recorded": len(these),
+            "rollouts": sum(row["scenarios"] for row in these), "success": sum(row["success"] for row in these)}
+    excluded = Counter(why for p in programs.table.values() if (why := not_arm_able(p)))
+    summary = {"source": programs.source.label(), "scenarios": scenarios, "seed": seed,
+               "source_programs": len(programs.table), "arm_able": len(programs.table) - sum(excluded.values()),
+               "not_arm_able": dict(excluded), "by_length": strata,
+               "concepts": len(rows), "of": len(concepts), "rollouts": len(records),
+               "success": sum(r["success"] for r in records),
+               "failures": dict(sum((Counter(row["failures"]) for row in rows), Counter())),
+               "parse": {"scenes": len(parsed), "scenes_exact": sum(p["exact"] for p in parsed),
+                         "objects": sum(p["objects"] for p in parsed),
+                         "objects_exact": sum(p["exact_objects"] for p in parsed),
+                         "largest_centre_error_m": max((p["centre_error_m"] for p in parsed), default=0.0)},
+               "per_concept": {row["concept"]: row["success"] / row["scenarios"] for row in rows}}
+    write_record(out / "summary.json", summary)
     return summary

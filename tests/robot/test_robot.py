@@ -129,6 +129,29 @@ def test_a_scene_the_camera_cannot_parse_is_a_parse_error(bench, monkeypatch):
     assert not v.success and v.cause == "parse error" and "no objects" in v.detail
 
 
+def test_a_parse_that_misses_an_object_is_a_failure_of_its_own(bench, monkeypatch):
+    """The arm must not be judged against a wrong parse: dropping one object of the true
+    scene, or reading a colour wrong, fails as "parse wrong" before anything moves."""
+    import dataclasses
+
+    program = reference_program(POINTED)
+    sc = scenarios_for(program, 1, seed=2)[0]
+    seen = {"scene": dataclasses.replace(sc.scene, objects=sc.scene.objects[1:])}
+    monkeypatch.setattr(bench.camera, "scene", lambda data: (seen["scene"], None))
+    v = judge(bench.model, bench.prepare(program, sc), None)
+    assert not v.success and v.cause == "parse wrong" and "1 of" in v.detail and "not seen" in v.detail
+    assert v.parse["found"] == len(sc.scene.objects) - 1 and not v.parse["exact"]
+    other = {"red": "green", "green": "blue", "blue": "yellow", "yellow": "red"}
+    o = sc.scene.objects[0]
+    seen["scene"] = dataclasses.replace(sc.scene, objects=(dataclasses.replace(o, color=other[o.color]),
+                                                           *sc.scene.objects[1:]))
+    v = judge(bench.model, bench.prepare(program, sc), None)
+    assert v.cause == "parse wrong" and "colour" in v.detail
+    seen["scene"] = sc.scene  # the truth itself: the parse check passes
+    p = bench.prepare(program, sc)
+    assert p.error is None and p.check.exact and sorted(p.check.match) == list(range(len(sc.scene.objects)))
+
+
 def test_mjx_rollout_agrees_with_the_c_reference(bench):
     """gymnax-style: the batched MJX rollout against the NumPy controller on C MuJoCo."""
     import jax
@@ -230,14 +253,17 @@ def test_video_of_a_rollout_is_written(bench, tmp_path):
 
 
 def test_stress_batches_are_drawn_the_same_each_time():
-    """A resumed `vcc robot stress` redraws a batch from (seed, batch) alone."""
-    from robot.scenario import arm_concepts
+    """A resumed `vcc robot stress` redraws a batch from (seed, batch) alone, from the
+    learned programs of the run of record."""
+    from robot.choice import arm_able
+    from robot.sources import RUN_OF_RECORD, Programs
     from robot.stress import draw_batch
 
-    a, b, c = draw_batch(7, 3, size=4), draw_batch(7, 3, size=4), draw_batch(7, 4, size=4)
+    learned = Programs(str(RUN_OF_RECORD))
+    a, b, c = (draw_batch(7, k, learned, size=4) for k in (3, 3, 4))
     assert [(n, s.seed, s.slots) for n, _, s in a] == [(n, s.seed, s.slots) for n, _, s in b]
     assert [s.seed for _, _, s in a] != [s.seed for _, _, s in c]
-    assert all(n in arm_concepts() for n, _, _ in a)
+    assert all(n in arm_able(learned.table) and p == learned.table[n] for n, p, _ in a)
 
 
 @pytest.mark.slow
@@ -245,46 +271,75 @@ def test_a_thousand_random_rollouts_stay_finite(tmp_path):
     """1,000 rollouts of random arm-compatible concepts on random scenarios, 32 at a time
     on MJX (`vcc robot stress`): every state finite, every scenario judged (about an hour
     and a half on one core)."""
+    from robot.sources import RUN_OF_RECORD, Programs
     from robot.stress import run_stress
 
-    s = run_stress(tmp_path, rollouts=1000, seed=7, log=lambda _: None)
+    s = run_stress(tmp_path, Programs(str(RUN_OF_RECORD)), rollouts=1000, seed=7, log=lambda _: None)
     assert s["rollouts"] >= 1000 and s["non_finite"] == 0
     assert s["rolled_out"] > 0.9 * s["rollouts"] and set(s["failures"]) <= set(CAUSES)
 
 
-def test_suite_writes_one_record_per_concept_and_resumes_without_redoing(tmp_path, monkeypatch):
-    """`vcc robot suite`: a finished concept's record is kept; a rerun does only what is left."""
+def test_suite_writes_one_record_per_scenario_and_resumes_without_redoing(tmp_path, monkeypatch):
+    """`vcc robot suite`: one file per concept with a record per scenario and the program's
+    source and hash; a finished concept is kept, and one made with another program,
+    source or seed is redone."""
     import json
 
     import robot.rollout
     from robot.judge import Verdict
+    from robot.sources import Programs
     from robot.suite import run_suite
 
     calls = []
 
     class FakeBench:
-        def run(self, programs, scenarios, keep=False):
-            calls.append(len(scenarios))
+        def run_pairs(self, items, keep=False):
+            calls.append(len(items))
             vs = [Verdict(k % 2 == 0, None if k % 2 == 0 else "object dropped", "", 0.0, s.seed)
-                  for k, s in enumerate(scenarios)]
+                  for k, (_, s) in enumerate(items)]
             return vs, {"compile_s": 0.0, "rollout_s": 0.0}, []
 
     monkeypatch.setattr(robot.rollout, "Bench", FakeBench)
+    run = tmp_path / "run"
+    run.mkdir()
+    found = ("scene_parse; fixate(bottom); top_down_attend; move_hand_to_attended_object; grab_object; "
+             "move_hand_to_pointer")
+    lines = [{"concept": "move_bottom_to_pointed", "found": True, "program": found},
+             {"concept": "move_green_to_right_bottom_corner", "found": True,
+              "program": reference_program("move_green_to_right_bottom_corner").text()}]
+    (run / "results.jsonl").write_text("".join(json.dumps(x) + "\n" for x in lines))
+    learned = Programs(str(run))
     two = ("move_bottom_to_pointed", "move_green_to_right_bottom_corner")
-    s = run_suite(tmp_path, scenarios=4, concepts=two[:1], log=lambda _: None)
+    out = tmp_path / "out"
+    s = run_suite(out, learned, two[:1], scenarios=4, log=lambda _: None)
     assert calls == [4] and s["success"] == 2 and s["failures"] == {"object dropped": 2}
-    s = run_suite(tmp_path, scenarios=4, concepts=two, log=lambda _: None)
+    s = run_suite(out, learned, two, scenarios=4, log=lambda _: None)
     assert calls == [4, 4] and s["concepts"] == 2 and s["rollouts"] == 8  # the first was not redone
-    record = json.loads((tmp_path / "move_bottom_to_pointed.json").read_text())
-    assert record["success"] == 2 and len(record["verdicts"]) == 4 and not list(tmp_path.glob("*.tmp"))
-    run_suite(tmp_path, scenarios=4, seed=1, concepts=two[:1], log=lambda _: None)
+    record = json.loads((out / "move_bottom_to_pointed.json").read_text())
+    assert record["programs"] == [found] and record["source"]["kind"] == "run"
+    assert record["source"]["path"] == str(run.resolve()) and len(record["source"]["sha256"]) == 64
+    assert [r["seed"] for r in record["records"]] == [0, 1, 2, 3] and record["success"] == 2
+    assert not list(out.glob("*.tmp"))
+    run_suite(out, learned, two[:1], scenarios=4, seed=1, log=lambda _: None)
     assert calls == [4, 4, 4]  # another seed is another run: redone, not kept
+    run_suite(out, Programs("reference"), two[:1], scenarios=4, seed=1, log=lambda _: None)
+    assert calls == [4, 4, 4, 4]  # another source (the reference program) too
+    # two concepts share one batch; a shard runs only its share
+    calls.clear()
+    fresh = tmp_path / "fresh"
+    run_suite(fresh, learned, two, scenarios=4, shard=(1, 2), log=lambda _: None)
+    assert calls == [4] and [p.name for p in fresh.glob("move_*.json")] == ["move_green_to_right_bottom_corner.json"]
+    run_suite(fresh, learned, two, scenarios=4, log=lambda _: None)
+    assert calls == [4, 4]
+    calls.clear()
+    run_suite(tmp_path / "both", learned, two, scenarios=4, log=lambda _: None)
+    assert calls == [8]
 
 
 def test_programs_come_from_an_induce_run_when_asked(tmp_path):
     import json
 
-    from robot.suite import programs_of
+    from robot.sources import programs_of
     from vccjax.errors import DataFileError
 
     found = ("scene_parse; fixate(bottom); top_down_attend; move_hand_to_attended_object; grab_object; "
@@ -304,7 +359,7 @@ def test_programs_come_from_an_induce_run_when_asked(tmp_path):
 
 
 def test_a_concept_saved_by_vcc_learn_is_carried_out_by_name(tmp_path, monkeypatch, capsys):
-    from robot.suite import programs_of
+    from robot.sources import Programs, programs_of
     from vcc.cli import main
     from vccjax.machine.program import parse
     from vccjax.world.user_concepts import save_concept
@@ -314,6 +369,10 @@ def test_a_concept_saved_by_vcc_learn_is_carried_out_by_name(tmp_path, monkeypat
     save_concept("lift_right_most", {"program": learned, "pairs": 3})
     assert programs_of("lift_right_most") == parse(learned)
     assert programs_of("lift_right_most+move_to_middle")[1] == reference_program("move_to_middle")
+    library = Programs("library")  # the suite's --source library
+    assert library.of("lift_right_most") == parse(learned) and library.source.kind == "library"
+    with pytest.raises(ValueError, match="move_to_middle: not in the user's library"):
+        library.of("lift_right_most+move_to_middle")
     save_concept("paint_it", {"program": "scene_parse; top_down_attend; fill_color(red)"})
     assert main(["robot", "run", "--concept", "paint_it", "--scenarios", "1"]) == 2  # refused before MJX starts
     assert "recolours an object" in capsys.readouterr().err
