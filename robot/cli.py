@@ -33,6 +33,11 @@ def _program(a: argparse.Namespace):
 
 def cmd_run(a: argparse.Namespace) -> int:
     program = _program(a)  # bad input ends here, before JAX and MuJoCo start
+    for flag, path, kinds in (("--video", a.video, (".mp4", ".avi")), ("--frames", a.frames, (".png", ".jpg", ".jpeg"))):
+        if path and Path(path).suffix.lower() not in kinds:
+            raise ValueError(f"{flag} {path}: write {' or '.join(kinds)}")
+    if a.scenarios < 1:
+        raise ValueError(f"--scenarios {a.scenarios}: must be positive")
     _setup_mjx(a)
     from robot.judge import CAUSES
     from robot.control import RECORD
@@ -40,7 +45,7 @@ def cmd_run(a: argparse.Namespace) -> int:
 
     bench = Bench()
     scenarios = scenarios_for(program, a.scenarios, a.seed)
-    verdicts, info, records = bench.run(program, scenarios, keep=a.video is not None)
+    verdicts, info, records = bench.run(program, scenarios, keep=bool(a.video or a.frames))
     for k, v in enumerate(verdicts):
         print(f"scenario {k:3d} (seed {v.seed}): " + ("ok  " if v.success else f"FAIL {v.cause}: ") + v.detail)
     ok = sum(v.success for v in verdicts)
@@ -48,15 +53,18 @@ def cmd_run(a: argparse.Namespace) -> int:
     print(f"compile {info['compile_s']:.1f} s, rollout {info['rollout_s']:.1f} s for {info['scenarios']} scenarios "
           f"x {info['simulated_s']:.1f} s simulated, perception and planning {info['prepare_s']:.1f} s")
     print("failures: " + (", ".join(f"{c} {causes[c]}" for c in CAUSES if causes[c]) or "none"))
-    if a.video:
-        from robot.video import write_video
+    if a.video or a.frames:
+        from robot.video import write_frames, write_video
 
         k = next((i for i, r in enumerate(records) if r is not None), None)
         if k is None:
             print("no scenario ran: no video")
-        else:
+        if k is not None and a.video:
             n = write_video(bench.model, scenarios[k], records[k], a.video, RECORD)
             print(f"video: {a.video} ({n} frames, scenario {k})")
+        if k is not None and a.frames:
+            n = write_frames(bench.model, scenarios[k], records[k], a.frames)
+            print(f"key frames: {a.frames} ({n}, scenario {k})")
     if a.json:
         Path(a.json).write_text(json.dumps({
             "concept": a.concept,
@@ -160,6 +168,7 @@ def add_commands(sub) -> None:
     r.add_argument("--scenarios", type=int, default=32, help="randomized scenarios (default 32)")
     r.add_argument("--seed", type=int, default=0)
     r.add_argument("--video", help="write one rollout as a video (.mp4 or .avi)")
+    r.add_argument("--frames", help="write that rollout's key frames side by side as a picture (.png or .jpg)")
     r.add_argument("--json", help="write the full report here")
     r.add_argument("--all-cores", action="store_true",
                    help="let XLA use every core (on a 2-core CPU this hung at 32 scenarios)")

@@ -35,3 +35,27 @@ def write_video(model: mujoco.MjModel, scenario, qs: np.ndarray, path: str | Pat
             out.write(cv2.cvtColor(r.render(), cv2.COLOR_RGB2BGR))
     out.release()
     return len(qs)
+
+
+def write_frames(model: mujoco.MjModel, scenario, qs: np.ndarray, path: str | Path, count: int = 6,
+                 size: int = 240, camera: str = "oblique") -> int:
+    """Write `count` key frames of recorded qpos `qs`, evenly spaced from start to end, side
+    by side as one picture (PNG or JPEG); returns the frame count."""
+    path = Path(path)
+    if path.suffix.lower() not in (".png", ".jpg", ".jpeg"):
+        raise ValueError(f"{path}: write .png or .jpg")
+    data = mujoco.MjData(model)
+    scenario.dress(model, data)
+    width = size * 4 // 3
+    shots = []
+    with mujoco.Renderer(model, size, width) as r:
+        for t in np.linspace(0, len(qs) - 1, count).round().astype(int):
+            data.qpos[:] = qs[t]
+            mujoco.mj_forward(model, data)
+            r.update_scene(data, camera=camera)
+            shots.append(r.render())
+    gap = np.full((size, 4, 3), 255, np.uint8)
+    strip = np.concatenate([x for s in shots for x in (s, gap)][:-1], axis=1)
+    if not cv2.imwrite(str(path), cv2.cvtColor(strip, cv2.COLOR_RGB2BGR)):
+        raise OSError(f"{path}: could not be written")
+    return count

@@ -231,7 +231,8 @@ def _write_report(a: argparse.Namespace, runs: Path) -> int:
     out = Path(a.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps({**st, "benchmark": "reproduce", "runs": str(runs), "rows": rows}, indent=1))
-    report.write(out.parent, rows, Path(a.report), st, Path(a.others) if a.others else None)
+    report.write(out.parent, rows, Path(a.report), st, Path(a.others) if a.others else None,
+                 Path(a.robot) if a.robot else None)
     print(f"{len(rows)} row runs -> {out}; report -> {a.report}")
     return 0
 
@@ -247,6 +248,8 @@ def _report_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument("--report", default="benchmarks/REPORT.md", help="the generated report")
     p.add_argument("--others", default="benchmarks/induction",
                    help="committed induction runs to list apart (default benchmarks/induction; '' for none)")
+    p.add_argument("--robot", default="benchmarks/robot",
+                   help="arm suites (folders with a summary.json) to list (default benchmarks/robot; '' for none)")
 
 
 def _concept_flags(p: argparse.ArgumentParser, sample: int) -> None:

@@ -181,6 +181,33 @@ def other_runs_section(folder: Path) -> list[str]:
     return lines + [""]
 
 
+def robot_section(folder: Path) -> list[str]:
+    """Every arm suite under `folder` (a summary.json written by `vcc robot suite`):
+    successes, failures by cause and the camera's parse against the true tables."""
+    found = []
+    for path in sorted(folder.glob("*/summary.json")) if folder.exists() else []:
+        try:
+            s = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError):
+            continue
+        if isinstance(s, dict) and "source" in s and "parse" in s:
+            found.append((path.parent, s))
+    if not found:
+        return []
+    lines = [f"## The arm (`{folder}`, `vcc robot suite`)", "",
+             "| folder | programs | concepts recorded | scenarios each | carried out | failures by cause | "
+             "objects parsed exact |", "|---|---|---|---|---|---|---|"]
+    for path, s in found:
+        src = s["source"]
+        where = f"{src['kind']} `{src['path']}`" if src.get("path") else src["kind"]
+        fails = ", ".join(f"{c} {n}" for c, n in sorted(s["failures"].items(), key=lambda x: -x[1])) or "none"
+        p = s["parse"]
+        lines.append(f"| `{path}` | {where} | {s['concepts']} of {s['of']} | {s['scenarios']} | "
+                     f"{s['success']} of {s['rollouts']} ({s['success'] / max(1, s['rollouts']):.1%}) | {fails} | "
+                     f"{p['objects_exact']} of {p['objects']} ({p['objects_exact'] / max(1, p['objects']):.2%}) |")
+    return lines + [""]
+
+
 def collect_rows(runs: Path) -> dict[str, dict]:
     """Every row folder under `runs` that holds a run, by folder name."""
     out = {}
@@ -192,7 +219,8 @@ def collect_rows(runs: Path) -> dict[str, dict]:
     return out
 
 
-def write(results_dir: Path, rows: dict[str, dict], out: Path, stamp: dict, others: Path | None = None) -> str:
+def write(results_dir: Path, rows: dict[str, dict], out: Path, stamp: dict, others: Path | None = None,
+          robot: Path | None = None) -> str:
     """`rows`: what `collect_rows` read (the caller writes them to the results JSON too)."""
     results = _load(results_dir)
     lines = ["# vccjax benchmark report", "",
@@ -201,6 +229,7 @@ def write(results_dir: Path, rows: dict[str, dict], out: Path, stamp: dict, othe
              f"Only measured numbers: each table names its result file or run folder.", ""]
     lines += targets_section(results, rows) + emulator_section(results) + search_section(results)
     lines += reproduce_section(rows) + (other_runs_section(others) if others else [])
+    lines += robot_section(robot) if robot else []
     text = "\n".join(lines)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)

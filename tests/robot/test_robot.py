@@ -179,6 +179,15 @@ def test_robot_cli_errors_are_one_line(capsys):
     for argv, message in [
         (["robot", "run", "--concept", "no_such_concept"], "unknown concept 'no_such_concept'"),
         (["robot", "run", "--concept", "x", "--program", "scene_parse; jump"], "unknown instruction"),
+        (["robot", "run", "--concept", POINTED, "--frames", "f.gif"], "--frames f.gif: write .png or .jpg"),
+        (["robot", "run", "--concept", POINTED, "--video", "v.mov"], "--video v.mov: write .mp4 or .avi"),
+        (["robot", "run", "--concept", POINTED, "--scenarios", "0"], "--scenarios 0: must be positive"),
+        (["robot", "suite", "--out", "x", "--concepts", "no_such_concept"], "no_such_concept: not induced in"),
+        (["robot", "suite", "--out", "x", "--concepts", "change_all_objs_color"], "recolours"),
+        (["robot", "suite", "--out", "x", "--shard", "2/2"], "--shard 2/2: K must be in 0..N-1"),
+        (["robot", "suite", "--out", "x", "--shard", "half"], "--shard half: give K/N"),
+        (["robot", "suite", "--out", "x", "--source", "no/such/run"], "results.jsonl: missing"),
+        (["robot", "suite", "--out", "x", "--scenarios", "0"], "--scenarios and --count must be positive"),
     ]:
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
@@ -250,6 +259,13 @@ def test_video_of_a_rollout_is_written(bench, tmp_path):
     cap = cv2.VideoCapture(str(path))
     ok, frame = cap.read()
     assert ok and frame.shape == (120, 212, 3)
+    from robot.video import write_frames
+
+    strip = tmp_path / "frames.png"
+    assert write_frames(bench.model, sc, qs, strip, count=3, size=60) == 3
+    assert cv2.imread(str(strip)).shape == (60, 3 * 80 + 2 * 4, 3)  # three 80 x 60 frames, 4-pixel gaps
+    with pytest.raises(ValueError, match="write .png or .jpg"):
+        write_frames(bench.model, sc, qs, tmp_path / "frames.gif")
 
 
 def test_stress_batches_are_drawn_the_same_each_time():

@@ -174,3 +174,25 @@ def test_bench_reproduce_refuses_an_unknown_row_or_scale(tmp_path, capsys):
     assert "unknown row(s): o2-magic" in capsys.readouterr().err
     assert main(_reproduce(tmp_path, "--rows", "examples-1", "--scale", "0")) == 2
     assert "--scale must be positive" in capsys.readouterr().err
+
+
+def test_the_report_lists_each_arm_suite_with_its_failures_and_parse(tmp_path):
+    """A suite's summary.json becomes one row: source, rate, failures by cause (most first),
+    objects parsed exact; a folder without a suite summary is skipped."""
+    from vcc.report import robot_section
+
+    suite = tmp_path / "learned"
+    suite.mkdir()
+    summary = {"source": {"kind": "run", "path": "benchmarks/induction/x", "sha256": "ab"}, "scenarios": 8,
+               "concepts": 3, "of": 4, "rollouts": 24, "success": 21,
+               "failures": {"object dropped": 1, "parse wrong": 2},
+               "parse": {"objects": 80, "objects_exact": 79, "scenes": 24, "scenes_exact": 23}}
+    (suite / "summary.json").write_text(json.dumps(summary))
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "summary.json").write_text(json.dumps({"rollouts": 3}))  # a stress summary: not a suite
+    lines = robot_section(tmp_path)
+    rows = [x for x in lines if x.startswith(f"| `{suite}`")]
+    assert len(rows) == 1 and len([x for x in lines if x.startswith("| `")]) == 1
+    assert rows[0] == (f"| `{suite}` | run `benchmarks/induction/x` | 3 of 4 | 8 | 21 of 24 ({21 / 24:.1%}) | "
+                       f"parse wrong 2, object dropped 1 | 79 of 80 ({79 / 80:.2%}) |")
+    assert robot_section(tmp_path / "none") == []

@@ -23,6 +23,6 @@ def test_notebook_runs_top_to_bottom(path, monkeypatch):
         "a notebook that draws nothing"
 
 
-def test_there_are_five_notebooks():
+def test_there_are_six_notebooks():
     assert [p.stem for p in sorted(NOTEBOOKS.glob("*.ipynb"))] == [
-        "01_emulator_traces", "02_induction", "03_argpred", "04_robot", "05_teach"]
+        "01_emulator_traces", "02_induction", "03_argpred", "04_robot", "05_teach", "06_zero_shot"]
