@@ -107,7 +107,7 @@ def _verdict(model: mujoco.MjModel, prepared, qs: np.ndarray | None) -> Verdict:
     opening = d.joint("finger_a").qpos[0]
     pads = {model.geom("pad_a").id, model.geom("pad_b").id}
     touching = any({int(c.geom1), int(c.geom2)} & pads for c in d.contact[: d.ncon])
-    top = max(final[k, 2] + BODIES[k].height / 2 for k in placed)
+    top = max(final[k, 2] - BODIES[k].height / 2 + BODIES[k].top for k in placed)
     if opening < 0.8 * float(kf.grip[-1]) or touching or tcp[-1, 2] - 0.015 < top + 0.01:
         return Verdict(False, "gripper not clear", f"opening {opening * 100:.1f} cm, tool at {tcp[-1, 2]:.3f} m"
                        + (", a pad touches an object" if touching else ""), worst, seed)

@@ -16,7 +16,8 @@ import functools
 
 import numpy as np
 
-from robot.world import APART, BODIES, TABLE_CENTRE, TABLE_HALF, TEXTURES, WORKSPACE_CENTRE, WORKSPACE_SIDE, Body
+from robot.world import (APART, BODIES, KNOB, TABLE_CENTRE, TABLE_HALF, TEXTURES, WORKSPACE_CENTRE, WORKSPACE_SIDE,
+                         Body)
 
 ARM_JOINTS = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
 HOME = (-1.5708, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)  # tool down, beside the workspace
@@ -35,13 +36,13 @@ def _fmt(v) -> str:
 
 
 def mesh_vertices(body: Body) -> np.ndarray | None:
-    """(V, 3) vertices of a body's convex hull, centred on its bounding box (None for a
+    """(V, 3) vertices of a body's mesh, centred on its plate or bounding box (None for a
     primitive). Under 32 vertices: MJX's hull collisions are measured fast up to there."""
     r, h = body.size / 2, body.height / 2
-    if body.kind == "prism":  # a triangle, apex towards +x (image up), its three corners cut flat
-        a = 0.003  # half the apex's flat; the base corners end in flats as long as 2a
-        tri = np.array([[r, a], [2 * a - r, r], [-r, r], [-r, -r], [2 * a - r, -r], [r, -a]])
-        return np.concatenate([np.c_[tri, np.full(6, -h)], np.c_[tri, np.full(6, h)]])
+    if body.kind in ("triangle", "star"):  # the VCC's outline (image up is world +x), as a plate
+        outline = _outline(body.kind, r)
+        return np.concatenate([np.c_[outline, np.full(len(outline), -h)], np.c_[outline, np.full(len(outline), h)],
+                               [[0.0, 0.0, -h], [0.0, 0.0, h]]])
     if body.kind == "lemon":  # a round body with a small flat bottom, so it stands
         ry = r * 0.86
         # the widest band is upright (rings in line), so a pad squeezing it pushes straight in, not down
@@ -51,6 +52,34 @@ def mesh_vertices(body: Body) -> np.ndarray | None:
         pts.append((0.0, 0.0, h))
         return np.array(pts)
     return None
+
+
+def _outline(kind: str, r: float) -> np.ndarray:
+    """The plate's outline in the body frame (world x = image up, world y = image left),
+    counter-clockwise seen from above; the centre is the VCC object's centre."""
+    from vccjax.machine.geometry import star_polygon
+
+    if kind == "star":
+        img = star_polygon(r)  # image (x right, y down), first point up
+    else:  # apex up at -r, base at +r, base width 2r
+        img = np.array([[0.0, -r], [-r, r], [r, r]])
+    world = np.stack([-img[:, 1], -img[:, 0]], 1)
+    area = np.sum(world[:, 0] * np.roll(world[:, 1], -1) - np.roll(world[:, 0], -1) * world[:, 1])
+    return world if area > 0 else world[::-1]
+
+
+def mesh_faces(body: Body) -> np.ndarray | None:
+    """Triangles of a plate's mesh (outward normals), so that a star renders as a star (its
+    collision is its convex hull); None where the hull of the vertices is the shape."""
+    if body.kind not in ("triangle", "star"):
+        return None
+    n = len(_outline(body.kind, body.size / 2))
+    bottom, top = n * 2, n * 2 + 1  # the centre vertices
+    faces = []
+    for i in range(n):
+        j = (i + 1) % n
+        faces += [(bottom, j, i), (top, n + i, n + j), (i, j, n + j), (i, n + j, n + i)]
+    return np.array(faces)
 
 
 def _object_xml(k: int, body: Body) -> str:
@@ -63,9 +92,17 @@ def _object_xml(k: int, body: Body) -> str:
         geom = f'<geom name="obj{k}" type="sphere" size="{body.size / 2:.6g}" {common}/>'
     else:
         geom = f'<geom name="obj{k}" type="mesh" mesh="mesh_{body.name}" {common}/>'
+    if body.knob:  # gripped like a small box; coloured with the plate (`knob_geom`)
+        side, tall = KNOB
+        geom += (f'<geom name="{knob_geom(k)}" type="box" size="{_fmt([side / 2, side / 2, tall / 2])}" '
+                 f'pos="0 0 {body.height / 2 + tall / 2:.6g}" {common}/>')
     x, y = parked_xy(k)
     return (f'<body name="slot{k}" pos="{_fmt([x, y, body.height / 2])}">'
             f'<freejoint name="slot{k}"/>{geom}</body>')
+
+
+def knob_geom(k: int) -> str:
+    return f"obj{k}_knob"
 
 
 def parked_xy(k: int) -> tuple[float, float]:
@@ -123,7 +160,8 @@ def _arm_xml() -> str:
 
 
 def _assets() -> str:
-    meshes = "".join(f'<mesh name="mesh_{b.name}" vertex="{_fmt(mesh_vertices(b))}"/>'
+    meshes = "".join(f'<mesh name="mesh_{b.name}" vertex="{_fmt(mesh_vertices(b))}"'
+                     + (f' face="{_fmt(mesh_faces(b))}"' if mesh_faces(b) is not None else "") + "/>"
                      for b in BODIES if mesh_vertices(b) is not None)
     return f"""
   <asset>

@@ -12,7 +12,10 @@ import numpy as np
 from robot.control import TICK, Keyframes
 from robot.mjcf import FINGER_OPEN
 from robot.plan import PickPlace, grip_yaw, set_down_clear
-from robot.world import WORKSPACE_SIDE, to_table
+from robot.world import BODIES, KNOB, WORKSPACE_SIDE, to_table
+
+PLATES = {b.kind: b for b in BODIES if b.knob}  # the shapes only a knobbed plate stands for
+TIPS_BELOW_TCP = 0.015  # the pads' tips below the tool centre point (robot/mjcf.py)
 
 SAFE_Z = 0.13  # tool centre above the table when moving between objects
 GRASP_Z = 0.018  # tool centre when closing on an object (pads end 1.5 cm lower)
@@ -90,14 +93,20 @@ def keyframes(moves: list[PickPlace], start: np.ndarray, start_yaw: float = 0.0,
 
 def grasp_z(shape: str, width: float) -> float:
     """Tool centre height for the grasp: a round object at its equator as seen from above
-    (a ball is as tall as it is wide), anything else at `GRASP_Z`."""
+    (a ball is as tall as it is wide), a plate (triangle, star) by its knob with the pads'
+    tips 4 mm above the plate, anything else at `GRASP_Z`."""
     if shape == "circle":
         return float(np.clip(width * WORKSPACE_SIDE / 2, GRASP_Z, 0.026))
+    if shape in PLATES:
+        return PLATES[shape].height + 0.004 + TIPS_BELOW_TCP
     return GRASP_Z
 
 
 def across(shape: str, width: float) -> float:
-    """Metres between the faces the fingers close on (a diamond is gripped across its sides)."""
+    """Metres between the faces the fingers close on (a diamond is gripped across its
+    sides, a plate across its knob)."""
+    if shape in PLATES:
+        return KNOB[0]
     return width * WORKSPACE_SIDE / (np.sqrt(2.0) if shape == "diamond" else 1.0)
 
 

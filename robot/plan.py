@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
-from robot.world import WORKSPACE_SIDE
+from robot.world import KNOB, WORKSPACE_SIDE
 from vccjax.machine.config import VCCConfig
 from vccjax.machine.geometry import object_pixels
 from vccjax.machine.instructions import NAMES, SHAPES
@@ -128,13 +128,17 @@ def grip_yaw(mv: PickPlace) -> float:
         choices = [0.0, np.pi / 2]
     elif mv.shape == "diamond":
         choices = [np.pi / 4, 3 * np.pi / 4]
-    elif mv.shape == "triangle":
-        choices = [0.0, np.pi / 2]  # base face against the apex's flat, or across the base corners' flats
+    elif mv.shape in ("triangle", "star"):
+        choices = [0.0, np.pi / 2]  # across the plate's square knob
     else:
         raise PlanError(f"no grasp for a {mv.shape}")
     (u0, v0), (u1, v1) = mv.path[-2], mv.path[-1]
     heading = float(np.arctan2(-(u1 - u0), -(v1 - v0)))  # world angle of the last leg (x = -v, y = -u)
-    half = (mv.width / (np.sqrt(2.0) if mv.shape == "diamond" else 1.0)) / 2 + ROOM + PAD / 2
+    if mv.shape in ("triangle", "star"):
+        across = KNOB[0] / WORKSPACE_SIDE
+    else:
+        across = mv.width / (np.sqrt(2.0) if mv.shape == "diamond" else 1.0)
+    half = across / 2 + ROOM + PAD / 2
 
     def clearance(yaw: float) -> float:
         du, dv = -np.sin(yaw), -np.cos(yaw)  # the finger axis in workspace terms

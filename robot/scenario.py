@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from robot.mjcf import HOME, N_DISTRACTORS, parked_xy
+from robot.mjcf import HOME, N_DISTRACTORS, knob_geom, parked_xy
 from robot.world import APART, BODIES, COLORS_RGB, TEXTURES, WORKSPACE_SIDE, to_table
 from vccjax.errors import SceneError
 from vccjax.world.pairs import uses_pointer
@@ -56,10 +56,10 @@ class Scenario:
 
     def dress(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         """What only the camera sees: colours, texture, pointer and distractor places."""
-        for k in range(len(BODIES)):
-            model.geom(f"obj{k}").rgba[:3] = (0.5, 0.5, 0.5)
-        for o, k in zip(self.scene.objects, self.slots):
-            model.geom(f"obj{k}").rgba[:3] = COLORS_RGB[o.color]
+        for k, body in enumerate(BODIES):
+            for g in (f"obj{k}", knob_geom(k)) if body.knob else (f"obj{k}",):
+                model.geom(g).rgba[:3] = COLORS_RGB[self.scene.objects[self.slots.index(k)].color] \
+                    if k in self.slots else (0.5, 0.5, 0.5)
         model.geom("table_top").matid = model.material(f"table_{self.texture}").id
         pointer = model.body("pointer").mocapid[0]
         if self.scene.pointer is not None:

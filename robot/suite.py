@@ -5,9 +5,10 @@ scenarios, judged against the scene truly on the table (`robot.judge`, `robot.tr
 One JSON file per concept, written when its batch finishes, holding one record per
 scenario (seed, verdict, parse check) and the program's source, text and hash; an
 interrupted run resumes where it stopped, and a record made with another program,
-source, seed or scenario count is redone, not mixed in. Scenarios of several concepts
-share one MJX batch. `shard` splits the concepts between processes that write into the
-same folder (each its own files), so that two single-core processes use two cores.
+source, seed, scenario count or world (`world_sha256`) is redone, not mixed in.
+Scenarios of several concepts share one MJX batch. `shard` splits the concepts between
+processes that write into the same folder (each its own files), so that two single-core
+processes use two cores.
 """
 
 from __future__ import annotations
@@ -55,6 +56,21 @@ def write_record(path: Path, record: dict) -> None:
     tmp.replace(path)
 
 
+def world_sha256() -> str:
+    """The arm's world (model, bodies, textures): a record made in another world is redone."""
+    import hashlib
+
+    from robot.mjcf import scene_xml
+
+    return hashlib.sha256(scene_xml().encode()).hexdigest()
+
+
+def _settings(programs: Programs, name: str, scenarios: int, seed: int) -> dict:
+    """What a record must have been made with to be kept on a resume."""
+    return {"scenarios": scenarios, "seed": seed, "source": programs.source.label(),
+            "program_sha256": program_sha256(programs.of(name)), "world_sha256": world_sha256()}
+
+
 def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scenarios: int = 8, seed: int = 0,
               log: Callable[[str], None] = print, shard: tuple[int, int] = (0, 1)) -> dict:
     """Run (or resume) `concepts` (this shard's share) into `out`; returns the summary
@@ -67,11 +83,9 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    source = programs.source.label()
 
     def settings(name: str) -> dict:
-        return {"scenarios": scenarios, "seed": seed, "source": source,
-                "program_sha256": program_sha256(programs.of(name))}
+        return _settings(programs, name, scenarios, seed)
 
     mine = list(concepts)[shard[0]::shard[1]]
     todo = [c for c in mine if not finished(file_of(out, c), **settings(c))]
@@ -121,8 +135,7 @@ def summarise(out: Path, programs: Programs, concepts: Sequence[str], scenarios:
     rows = []
     for name in concepts:
         path = file_of(out, name)
-        if finished(path, scenarios=scenarios, seed=seed, source=programs.source.label(),
-                    program_sha256=program_sha256(programs.of(name))):
+        if finished(path, **_settings(programs, name, scenarios, seed)):
             rows.append(json.loads(path.read_text()))
     from robot.choice import STRATA, length, not_arm_able
 

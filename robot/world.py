@@ -45,20 +45,33 @@ class Body:
     the table, where, in which colour, and how a box is turned)."""
 
     name: str
-    kind: str  # "box", "ball", "lemon", "prism"
-    size: float  # metres across (box: side; ball: diameter; lemon: length; prism: base = height)
-    height: float  # metres
+    kind: str  # "box", "ball", "lemon", "triangle" or "star" (a plate of that shape with a knob)
+    size: float  # metres across (box: side; ball: diameter; lemon: length; plates: bounding width)
+    height: float  # metres (a plate: its thickness, the knob not counted)
 
     @property
     def shapes(self) -> tuple[str, ...]:
         """The VCC shapes this body can be seen as from above."""
-        return {"box": ("square", "diamond"), "prism": ("triangle",)}.get(self.kind, ("circle",))
+        return {"box": ("square", "diamond"), "triangle": ("triangle",), "star": ("star",)}.get(self.kind, ("circle",))
+
+    @property
+    def knob(self) -> bool:
+        """A plate with a square knob in its middle: a triangle or a star has no two parallel
+        faces to grip, and a triangular prism gripped at a corner tipped out of the fingers."""
+        return self.kind in ("triangle", "star")
+
+    @property
+    def top(self) -> float:
+        """Metres from its bottom to its highest point."""
+        return self.height + (KNOB[1] if self.knob else 0.0)
 
     def width(self, shape: str) -> float:
         """Its bounding width in workspace units when seen as `shape`."""
         across = self.size * (np.sqrt(2.0) if shape == "diamond" else 1.0)
         return float(across / WORKSPACE_SIDE)
 
+
+KNOB = (0.016, 0.035)  # a plate's knob: side and height (metres), gripped like a small box
 
 BODIES: tuple[Body, ...] = (
     Body("box_s", "box", 0.036, 0.035),
@@ -67,12 +80,12 @@ BODIES: tuple[Body, ...] = (
     Body("ball_s", "ball", 0.040, 0.040),
     Body("ball_l", "ball", 0.050, 0.050),
     Body("lemon", "lemon", 0.054, 0.042),
+    Body("triangle", "triangle", 0.050, 0.012),
+    Body("star", "star", 0.060, 0.012),
 )
 # Bodies that never stand on the table together need no contact (MJX computes every allowed
-# pair every step). A triangular prism (corners cut flat) was tried as a seventh body and
-# dropped: it tipped out of the grip in 7 of 32 rollouts of a triangle-stacking concept, so
-# concepts that need triangles (or stars) are not carried out on the arm.
-APART: tuple[tuple[str, str], ...] = ()
+# pair every step, and hull against hull is the dearest): the three hulls never meet.
+APART: tuple[tuple[str, str], ...] = (("lemon", "triangle"), ("lemon", "star"), ("triangle", "star"))
 
 COLORS_RGB: dict[str, tuple[float, float, float]] = {
     "red": (0.85, 0.08, 0.08), "green": (0.10, 0.62, 0.18),
