@@ -137,6 +137,33 @@ def cmd_suite(a: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_perception(a: argparse.Namespace) -> int:
+    if a.scenes < 1:
+        raise ValueError(f"--scenes {a.scenes}: must be positive")
+    out = Path(a.out)
+    if out.suffix != ".json":
+        raise ValueError(f"--out {a.out}: write a .json file")
+    runtime.prepare(cores=1)
+    from tqdm import tqdm
+
+    from robot.perception_sweep import CONDITIONS, sweep
+
+    bar = tqdm(total=a.scenes * len(CONDITIONS), desc="camera parse", unit="scene")
+    table = sweep(a.scenes, a.seed, progress=bar.update)
+    bar.close()
+    for name, t in table.items():
+        print(f"{name:32s} objects exact {t['objects_exact']} of {t['objects']} "
+              f"({t['objects_exact'] / max(1, t['objects']):.2%}), scenes exact {t['scenes_exact']} of {t['scenes']}, "
+              f"largest centre error {t['largest_centre_error_m'] * 1000:.1f} mm")
+    record = {**runtime.provenance(f"vcc robot perception --scenes {a.scenes} --seed {a.seed} --out {a.out}"),
+              "benchmark": "robot-perception", "scenes": a.scenes, "seed": a.seed, "conditions": table}
+    tmp = out.with_suffix(".tmp")
+    tmp.write_text(json.dumps(record, indent=1))
+    tmp.replace(out)
+    print(f"-> {out}")
+    return 0
+
+
 def cmd_stress(a: argparse.Namespace) -> int:
     from robot.sources import Programs, RUN_OF_RECORD
 
@@ -192,6 +219,15 @@ def add_commands(sub) -> None:
                    help="run only every N-th concept from the K-th: N processes on one folder, one core each")
     u.add_argument("--all-cores", action="store_true", help="let XLA use every core")
     u.set_defaults(fn=cmd_suite)
+
+    c = s.add_parser("perception", help="the arm camera's parse against the true tables, nominal and harder",
+                     description="Render the suite's scenes from the top camera under nominal light, dimmer and "
+                                 "brighter light, and with the camera a few millimetres and degrees off its "
+                                 "calibration; parse each and check it against the objects truly on the table.")
+    c.add_argument("--out", required=True, help="result JSON")
+    c.add_argument("--scenes", type=int, default=200, help="scenes per condition (default 200)")
+    c.add_argument("--seed", type=int, default=0)
+    c.set_defaults(fn=cmd_perception)
 
     t = s.add_parser("stress", help="many rollouts of random concepts and scenarios: no NaN, no crash (resumable)")
     t.add_argument("--out", required=True, help="results folder (an existing one is resumed)")

@@ -5,11 +5,7 @@ stamped with the date, commit, machine and the exact command."""
 from __future__ import annotations
 
 import argparse
-import datetime
 import json
-import os
-import platform
-import subprocess
 import time
 from collections import Counter
 from pathlib import Path
@@ -18,28 +14,9 @@ from pathlib import Path
 def stamp(a: argparse.Namespace, benchmark: str) -> dict:
     """Where and when a measurement was made, and the command that made it (rebuilt from the
     parsed settings, so a bench called from Python is stamped as truly as one from the shell)."""
-    import jax
+    from vccjax import runtime
 
-    cpu = platform.processor()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                                cwd=Path(__file__).parent, timeout=10).stdout.strip() or None
-    except (OSError, subprocess.SubprocessError):
-        commit = None
-    return {
-        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "commit": commit, "command": command_line(a, benchmark),
-        "machine": {"cores": os.cpu_count(), "cpu": cpu, "python": platform.python_version(),
-                    "jax": jax.__version__, "devices": [str(d) for d in jax.devices()]},
-    }
-
+    return runtime.provenance(command_line(a, benchmark))
 
 
 def command_line(a: argparse.Namespace, benchmark: str) -> str:

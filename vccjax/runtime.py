@@ -102,3 +102,33 @@ def program_from_arg(text: str):
             raise VCCError(f"{path}: no such program file")
         text = path.read_text()
     return parse(text, body_max=DEFAULT_CONFIG.body_max)
+
+
+def provenance(command: str) -> dict:
+    """Where and when a measurement was made (UTC date, git commit, machine and JAX
+    devices), and the command that made it: what every result file carries."""
+    import datetime
+    import platform
+    import subprocess
+
+    import jax
+
+    cpu = platform.processor()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                                cwd=Path(__file__).parent, timeout=10).stdout.strip() or None
+    except (OSError, subprocess.SubprocessError):
+        commit = None
+    return {
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "commit": commit, "command": command,
+        "machine": {"cores": os.cpu_count(), "cpu": cpu, "python": platform.python_version(),
+                    "jax": jax.__version__, "devices": [str(d) for d in jax.devices()]},
+    }
