@@ -67,6 +67,7 @@ def cmd_run(a: argparse.Namespace) -> int:
             print(f"key frames: {a.frames} ({n}, scenario {k})")
     if a.json:
         Path(a.json).write_text(json.dumps({
+            **runtime.provenance(f"vcc robot run --concept {a.concept} --scenarios {a.scenarios} --seed {a.seed}"),
             "concept": a.concept,
             "program": [p.text() for p in (program if isinstance(program, list) else [program])],
             "scenarios": a.scenarios, "seed": a.seed,
