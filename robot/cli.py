@@ -124,12 +124,19 @@ def cmd_suite(a: argparse.Namespace) -> int:
         raise ValueError("--scenarios and --count must be positive")
     shard = _shard(a.shard)
     programs, names = _suite_programs(a)  # bad input ends here, before JAX and MuJoCo start
-    _setup_mjx(a)
-    from robot.suite import run_suite
-
     print(f"{len(names)} concepts from {programs.source.kind} {programs.source.path or ''}, "
           f"{a.scenarios} scenarios each" + (f", shard {a.shard}" if a.shard != "0/1" else ""))
-    s = run_suite(a.out, programs, names, a.scenarios, a.seed, shard=shard)
+    if a.status:
+        from robot.suite import summarise
+
+        if not Path(a.out).is_dir():
+            raise ValueError(f"--out {a.out}: no such run folder")
+        s = summarise(Path(a.out), programs, names, a.scenarios, a.seed)
+    else:
+        _setup_mjx(a)
+        from robot.suite import run_suite
+
+        s = run_suite(a.out, programs, names, a.scenarios, a.seed, shard=shard)
     print("failures: " + (", ".join(f"{c} {n}" for c, n in s["failures"].items()) or "none"))
     p = s["parse"]
     print(f"parse: {p['objects_exact']} of {p['objects']} objects exact, {p['scenes_exact']} of {p['scenes']} scenes")
@@ -218,6 +225,8 @@ def add_commands(sub) -> None:
     u.add_argument("--seed", type=int, default=0)
     u.add_argument("--shard", default="0/1", metavar="K/N",
                    help="run only every N-th concept from the K-th: N processes on one folder, one core each")
+    u.add_argument("--status", action="store_true",
+                   help="only summarise what the folder holds (summary.json), running nothing")
     u.add_argument("--all-cores", action="store_true", help="let XLA use every core")
     u.set_defaults(fn=cmd_suite)
 

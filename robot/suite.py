@@ -125,6 +125,7 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
             write_record(file_of(out, name), record)
             log(f"{name}: {record['success']} of {scenarios}")
             bar.update(1)
+        summarise(out, programs, concepts, scenarios, seed)  # a partial run reads as far as it went
     bar.close()
     return summarise(out, programs, concepts, scenarios, seed)
 

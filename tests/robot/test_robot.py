@@ -393,6 +393,17 @@ def test_suite_writes_one_record_per_scenario_and_resumes_without_redoing(tmp_pa
     assert calls == [8]
 
 
+def test_suite_status_summarises_a_folder_without_running(tmp_path, capsys):
+    import json
+
+    from vcc.cli import main
+
+    assert main(["robot", "suite", "--out", str(tmp_path), "--concepts", "move_all_yellow_left", "--status"]) == 0
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["concepts"] == 0 and s["of"] == 1 and s["source"]["path"] == "benchmarks/induction/o1-oracle-500k"
+    assert "0 of 1 concepts recorded" in capsys.readouterr().out
+
+
 def test_programs_come_from_an_induce_run_when_asked(tmp_path):
     import json
 
