@@ -208,6 +208,20 @@ def robot_section(folder: Path) -> list[str]:
     return lines + [""]
 
 
+def camera_section(results: list[tuple[str, dict]]) -> list[str]:
+    """The arm camera's parse against the true tables (`vcc robot perception`), per condition."""
+    runs = _latest(results, "robot-perception")
+    if not runs:
+        return []
+    name, d = runs[-1]
+    lines = ["## The arm's camera: parse against the true tables", "", _stamp(name, d), "",
+             "| condition | objects exact | scenes exact | largest centre error |", "|---|---|---|---|"]
+    for cond, t in d["conditions"].items():
+        lines.append(f"| {cond} | {t['objects_exact']} of {t['objects']} ({t['objects_exact'] / max(1, t['objects']):.2%})"
+                     f" | {t['scenes_exact']} of {t['scenes']} | {t['largest_centre_error_m'] * 1000:.1f} mm |")
+    return lines + [""]
+
+
 def collect_rows(runs: Path) -> dict[str, dict]:
     """Every row folder under `runs` that holds a run, by folder name."""
     out = {}
@@ -229,7 +243,7 @@ def write(results_dir: Path, rows: dict[str, dict], out: Path, stamp: dict, othe
              f"Only measured numbers: each table names its result file or run folder.", ""]
     lines += targets_section(results, rows) + emulator_section(results) + search_section(results)
     lines += reproduce_section(rows) + (other_runs_section(others) if others else [])
-    lines += robot_section(robot) if robot else []
+    lines += (robot_section(robot) if robot else []) + camera_section(results)
     text = "\n".join(lines)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(text)

@@ -196,3 +196,15 @@ def test_the_report_lists_each_arm_suite_with_its_failures_and_parse(tmp_path):
     assert rows[0] == (f"| `{suite}` | run `benchmarks/induction/x` | 3 of 4 | 8 | 21 of 24 ({21 / 24:.1%}) | "
                        f"parse wrong 2, object dropped 1 | 79 of 80 ({79 / 80:.2%}) |")
     assert robot_section(tmp_path / "none") == []
+
+
+def test_the_report_tabulates_the_camera_sweep_of_the_latest_file():
+    from vcc.report import camera_section
+
+    cond = {"nominal": {"objects": 40, "objects_exact": 39, "scenes": 10, "scenes_exact": 9,
+                        "largest_centre_error_m": 0.0025}}
+    old = {"benchmark": "robot-perception", "date": "2031-01-01", "conditions": {}}
+    new = {"benchmark": "robot-perception", "date": "2031-02-01", "conditions": cond}
+    lines = camera_section([("a.json", new), ("b.json", old)])
+    assert f"| nominal | 39 of 40 ({39 / 40:.2%}) | 9 of 10 | 2.5 mm |" in lines
+    assert any("`a.json`" in x for x in lines) and camera_section([]) == []
