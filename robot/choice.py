@@ -3,15 +3,17 @@ stated, stratified choice of them.
 
 A program is arm-able when it grabs something and does nothing a hand cannot: no
 recolouring or removal (`robot.plan.NOT_ON_A_ROBOT`), no imagined objects (they would
-block carries), and no attention to a shape none of the arm's bodies has (triangles and
-stars: `robot.world.BODIES`).
+block carries), and no attention to a shape none of the arm's bodies has
+(`robot.world.BODIES`: every VCC shape has one).
 
 The default choice stratifies by program length (instructions, loops counted once as
 written), because length is what makes a concept hard for the arm (more carries, more
 chances to drop or misplace): a stratum of at most `WHOLE` concepts is taken whole, and
 the other strata share the rest of `count` in proportion to their sizes, each a seeded
-sample. With the run of record this takes every concept of 9 to 12 and of 16 or more
-instructions, and samples the large strata of short programs and of 13, 14 and 15.
+sample (if the small strata alone exceed `count`, all strata share it). The choice is
+seeded apart from the scenarios, so every suite picks the same concepts. With the run of
+record this takes every concept of 9 to 12 and of 16 or more instructions, and samples
+the large strata of short programs and of 13, 14 and 15.
 """
 
 from __future__ import annotations
@@ -66,6 +68,8 @@ def default_choice(programs: Mapping[str, Program], count: int = COUNT, seed: in
     strata = [[c for c in able if lo <= length(programs[c]) <= hi] for lo, hi in STRATA]
     whole = [s for s in strata if len(s) <= WHOLE]
     rest = [s for s in strata if len(s) > WHOLE]
+    if sum(len(s) for s in whole) > count:  # a small count: every stratum shares it
+        whole, rest = [], [s for s in strata if s]
     left = max(count - sum(len(s) for s in whole), 0)
     total = sum(len(s) for s in rest)
     # largest remainder: each sampled stratum gets its share of what is left, rounded fairly

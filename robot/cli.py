@@ -95,6 +95,9 @@ def _suite_programs(a: argparse.Namespace):
     induced = {"run": programs, "reference": None, "library": programs}[programs.source.kind]
     if a.concepts:
         names = list(TEN) if a.concepts == "ten" else [c.strip() for c in a.concepts.split(",") if c.strip()]
+        names = list(dict.fromkeys(names))  # a name given twice runs once
+        if not names:
+            raise ValueError("--concepts: no concept named")
         for name in names:
             why = not_arm_able(programs.of(name))  # an unknown name is refused here too
             if why:
@@ -102,7 +105,7 @@ def _suite_programs(a: argparse.Namespace):
     else:
         table = (induced or Programs(str(RUN_OF_RECORD))).table
         names = sorted(arm_able(table)) if a.all or programs.source.kind == "library" else \
-            default_choice(table, a.count, a.seed)
+            default_choice(table, a.count)
         names = [c for c in names if c in programs and not not_arm_able(programs.of(c))]
     if not names:
         raise ValueError(f"--source {programs.source.path or programs.source.kind}: no concept an arm can carry out")
@@ -226,7 +229,7 @@ def add_commands(sub) -> None:
     u.add_argument("--shard", default="0/1", metavar="K/N",
                    help="run only every N-th concept from the K-th: N processes on one folder, one core each")
     u.add_argument("--status", action="store_true",
-                   help="only summarise what the folder holds (summary.json), running nothing")
+                   help="only summarise what the folder holds (writes summary.json), running no rollout")
     u.add_argument("--all-cores", action="store_true", help="let XLA use every core")
     u.set_defaults(fn=cmd_suite)
 

@@ -65,7 +65,8 @@ def sweep(scenes: int, seed: int = 0, conditions: Sequence[Condition] = CONDITIO
     camera = Camera(model)
     cam = camera.cam
     base = (model.cam_pos[cam].copy(), model.cam_quat[cam].copy())
-    lights = (model.light_diffuse.copy(), model.vis.headlight.diffuse.copy(), model.vis.headlight.ambient.copy())
+    lights = (model.light_diffuse.copy(), model.vis.headlight.diffuse.copy(), model.vis.headlight.ambient.copy(),
+              model.light_ambient.copy())
     rng = np.random.default_rng([seed, 0x9E7])
     staged = []
     for k in range(scenes):
@@ -78,6 +79,7 @@ def sweep(scenes: int, seed: int = 0, conditions: Sequence[Condition] = CONDITIO
         model.light_diffuse[:] = lights[0] * cond.light
         model.vis.headlight.diffuse[:] = lights[1] * cond.light
         model.vis.headlight.ambient[:] = lights[2] * cond.light
+        model.light_ambient[:] = lights[3] * cond.light
         tally = {"scenes": 0, "scenes_exact": 0, "objects": 0, "objects_exact": 0, "parse_errors": 0,
                  "centre_errors_m": []}
         for sc in staged:
@@ -99,6 +101,8 @@ def sweep(scenes: int, seed: int = 0, conditions: Sequence[Condition] = CONDITIO
                 parsed, _ = camera.scene(data, pose=calibrated)
             except SceneError:
                 tally["parse_errors"] += 1
+                if progress:
+                    progress(1)
                 continue
             c = check_parse(sc.scene, parsed)
             tally["scenes_exact"] += c.exact

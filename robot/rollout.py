@@ -88,9 +88,12 @@ class Bench:
         `keep`) each scenario's recorded qpos."""
         return self.run_pairs([(program, s) for s in scenarios], keep)
 
-    def run_pairs(self, items: list[tuple[Program | list[Program], Scenario]], keep: bool = False
-                  ) -> tuple[list[Verdict], dict, list[np.ndarray | None]]:
-        """As `run`, each scenario with its own program."""
+    def run_pairs(self, items: list[tuple[Program | list[Program], Scenario]], keep: bool = False,
+                  pad_to: int | None = None) -> tuple[list[Verdict], dict, list[np.ndarray | None]]:
+        """As `run`, each scenario with its own program. With `pad_to`, the batch rolled out
+        is always that size (the last live scenario repeated, its copies thrown away): MJX
+        compiles once per batch size, and a few scenarios refused by the parse or the plan
+        would otherwise cost a compilation of minutes."""
         t0 = time.perf_counter()
         prepared = [self.prepare(program, s) for program, s in items]
         t_prep = time.perf_counter() - t0
@@ -100,8 +103,9 @@ class Bench:
         ticks = 0
         if live:
             ticks = max(p.ticks for p in live) + 25
-            q0 = jnp.asarray(np.stack([p.scenario.qpos(self.model) for p in live]))
-            kf = jax.tree.map(lambda *x: jnp.asarray(np.stack(x)), *[p.keyframes for p in live])
+            rows = live + [live[-1]] * max(0, (pad_to or 0) - len(live))
+            q0 = jnp.asarray(np.stack([p.scenario.qpos(self.model) for p in rows]))
+            kf = jax.tree.map(lambda *x: jnp.asarray(np.stack(x)), *[p.keyframes for p in rows])
             t1 = time.perf_counter()
             self.arm.compile(q0, kf)  # apart from the run (cached per batch size)
             t_compile = time.perf_counter() - t1

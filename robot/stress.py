@@ -27,8 +27,14 @@ def draw_batch(seed: int, batch: int, programs: Programs, size: int = BATCH) -> 
 
     rng = np.random.default_rng([seed, batch])
     names = sorted(arm_able(programs.table))
-    items = []
+    if not names:
+        raise SceneError(f"{programs.source.path or programs.source.kind}: no concept an arm can carry out")
+    items, tries = [], 0
     while len(items) < size:
+        tries += 1
+        if tries > 50 * size:
+            raise SceneError(f"batch {batch}: the arm's bodies could stage only {len(items)} of {size} "
+                             f"scenarios in {tries - 1} draws")
         name = names[int(rng.integers(len(names)))]
         program = programs.table[name]
         try:
@@ -45,7 +51,7 @@ def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: 
 
     from robot.judge import tally
     from robot.rollout import Bench
-    from robot.suite import finished, write_record
+    from robot.suite import finished, world_sha256, write_record
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -53,7 +59,7 @@ def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: 
     bench = None
     for b in tqdm(range(batches), desc="robot stress", unit="batch"):
         path = out / f"batch-{b:03d}.json"
-        if finished(path, seed=seed, source=programs.source.label()):
+        if finished(path, seed=seed, source=programs.source.label(), world_sha256=world_sha256()):
             continue
         bench = bench or Bench()
         items = draw_batch(seed, b, programs)
@@ -61,7 +67,8 @@ def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: 
         verdicts, info, kept = bench.run_pairs([(p, s) for _, p, s in items], keep=True)
         info["wall_s"] = time.perf_counter() - start
         finite = [q is None or bool(np.isfinite(q).all()) for q in kept]
-        record = {"batch": b, "seed": seed, "source": programs.source.label(), "timing": info,
+        record = {"batch": b, "seed": seed, "source": programs.source.label(), "world_sha256": world_sha256(),
+                  "timing": info,
                   "concepts": [n for n, _, _ in items], "scenario_seeds": [s.seed for _, _, s in items],
                   "rolled_out": sum(q is not None for q in kept), "non_finite": finite.count(False),
                   **tally(verdicts)}

@@ -42,17 +42,28 @@ def file_of(out: Path, name: str) -> Path:
 
 def finished(path: Path, **expected) -> bool:
     """Whether `path` holds a record made with these settings (a resume keeps it; one
-    made with other settings is redone, not mixed in)."""
+    made with other settings is redone, not mixed in). A source matches on its kind and
+    folder: its hash is kept as provenance, and a run or library that gained other
+    concepts leaves this one's record good (`program_sha256` says what ran)."""
     if not path.exists():
         return False
     record = json.loads(path.read_text())
-    return all(record.get(k) == v for k, v in expected.items())
+    for k, v in expected.items():
+        got = record.get(k)
+        if k == "source" and isinstance(got, dict):
+            got, v = (got.get("kind"), got.get("path")), (v.get("kind"), v.get("path"))
+        if got != v:
+            return False
+    return True
 
 
 def write_record(path: Path, record: dict) -> None:
-    """Whole or not at all, if the run is killed while writing (a resume trusts it)."""
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(record, indent=1))
+    """Whole or not at all, if the run is killed while writing (a resume trusts it); each
+    process through its own temporary file, since shards share the summary."""
+    import os
+
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(record, indent=1, allow_nan=False))
     tmp.replace(path)
 
 
@@ -87,7 +98,8 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
     def settings(name: str) -> dict:
         return _settings(programs, name, scenarios, seed)
 
-    mine = list(concepts)[shard[0]::shard[1]]
+    concepts = list(dict.fromkeys(concepts))  # a name given twice runs once
+    mine = concepts[shard[0]::shard[1]]
     todo = [c for c in mine if not finished(file_of(out, c), **settings(c))]
     bench = None
     bar = tqdm(total=len(todo), desc="robot suite", unit="concept")
@@ -110,7 +122,7 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
                 from robot.rollout import Bench
 
                 bench = Bench()
-            verdicts, info, _ = bench.run_pairs([(p, sc) for _, p, sc in items])
+            verdicts, info, _ = bench.run_pairs([(p, sc) for _, p, sc in items], pad_to=BATCH)
         for (name, _, sc), v in zip(items, verdicts, strict=True):
             staged.setdefault(name, {})[sc.seed] = v
         info["wall_s"] = time.perf_counter() - start
@@ -121,13 +133,18 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
             record = {"concept": name, **settings(name), "programs": texts, "batch": {"concepts": group, **info},
                       "success": sum(v.success for v in runs),
                       "failures": dict(Counter(v.cause for v in runs if not v.success)),
-                      "records": [v.__dict__ for v in runs]}
+                      "records": [_plain(v.__dict__) for v in runs]}
             write_record(file_of(out, name), record)
             log(f"{name}: {record['success']} of {scenarios}")
             bar.update(1)
         summarise(out, programs, concepts, scenarios, seed)  # a partial run reads as far as it went
     bar.close()
     return summarise(out, programs, concepts, scenarios, seed)
+
+
+def _plain(d: dict) -> dict:
+    """A record as strict JSON: a placement error not measured (nan) is null."""
+    return {k: (None if isinstance(v, float) and v != v else v) for k, v in d.items()}
 
 
 def summarise(out: Path, programs: Programs, concepts: Sequence[str], scenarios: int, seed: int) -> dict:

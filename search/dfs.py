@@ -110,8 +110,9 @@ class _Budget:
     def found(self, cost: int, path: np.ndarray) -> None:
         """A program that explains every example: keep it if it is the cheapest so far."""
         alt = self.alternatives
-        key = alt.behaviour(path) if alt is not None and alt.behaviour is not None else None
-        fit = (cost, path.copy(), key)
+        wanted = alt is not None and alt.behaviour is not None and (
+            self.best is None or cost <= self.best[0] + alt.margin_bins)  # the key runs programs: only when kept
+        fit = (cost, path.copy(), alt.behaviour(path) if wanted else None)
         if self.best is None or cost < self.best[0]:
             self.best = fit
         if alt is not None:  # the `keep` cheapest within the margin (stable: ties in finding order)

@@ -128,8 +128,8 @@ def alternatives_for(chain: Chain, settings: LearnSettings, budget: int,
     on `rival_probes` fresh scenes like them, so that `max_rivals` counts behaviours."""
     margin = int(math.ceil(settings.rival_margin_nats / chain.delta))
     behaviour = None
-    if inputs and settings.rival_probes:
-        probes = fresh_scenes(inputs, settings.rival_probes, settings.seed, DEFAULT_CONFIG)
+    probes = fresh_scenes(inputs, settings.rival_probes, settings.seed, DEFAULT_CONFIG) if inputs else []
+    if len(probes) >= max(4, settings.rival_probes // 2):  # too few scenes would merge what differs
 
         def behaviour(path: np.ndarray) -> tuple:
             return tuple(outcomes(program_of(chain, [int(x) for x in path if x >= 0]), probes, DEFAULT_CONFIG))

@@ -350,7 +350,8 @@ def test_suite_writes_one_record_per_scenario_and_resumes_without_redoing(tmp_pa
     calls = []
 
     class FakeBench:
-        def run_pairs(self, items, keep=False):
+        def run_pairs(self, items, keep=False, pad_to=None):
+            assert pad_to == 32  # every batch one size: one MJX compilation
             calls.append(len(items))
             vs = [Verdict(k % 2 == 0, None if k % 2 == 0 else "object dropped", "", 0.0, s.seed)
                   for k, (_, s) in enumerate(items)]
@@ -446,3 +447,23 @@ def test_a_concept_saved_by_vcc_learn_is_carried_out_by_name(tmp_path, monkeypat
     assert "recolours an object" in capsys.readouterr().err
     assert main(["robot", "run", "--concept", "no_such_saved"]) == 2
     assert "not in your library" in capsys.readouterr().err
+
+
+def test_a_batch_is_padded_to_one_size_and_the_copies_thrown_away(bench, monkeypatch):
+    """MJX compiles once per batch size: a suite batch is always rolled out at `pad_to`,
+    however many scenarios the parse or the plan refused, and only the real ones judged."""
+    program = reference_program(POINTED)
+    scenarios = scenarios_for(program, 3, seed=0)
+    shapes = []
+
+    class FakeArm:
+        def compile(self, q0, kf):
+            shapes.append(q0.shape[0])
+
+        def rollout(self, q0, kf, ticks):
+            return np.repeat(np.asarray(q0)[:, None, :], 2, axis=1)  # stands still: every verdict a failure
+
+    monkeypatch.setattr(bench, "arm", FakeArm())
+    verdicts, info, kept = bench.run_pairs([(program, s) for s in scenarios], keep=True, pad_to=8)
+    assert shapes == [8] and len(verdicts) == len(kept) == 3 and info["scenarios"] == 3
+    assert all(q is not None and q.shape[0] == 2 for q in kept)

@@ -105,6 +105,8 @@ def test_the_default_choice_takes_small_strata_whole_and_shares_the_rest_by_size
     left = 150 - 35  # shared by 60 and 200 in proportion: 26.5 and 88.5, rounded to sum 115
     assert by[6] + by[14] == left and abs(by[6] - left * 60 / 260) <= 1 and abs(by[14] - left * 200 / 260) <= 1
     assert default_choice(programs, 150, seed=0) == chosen and default_choice(programs, 150, seed=1) != chosen
+    small = default_choice(programs, 20)  # fewer than the small strata hold: every stratum shares it
+    assert len(small) == 20 and {n for n in sizes if any(c.startswith(f"c{n}_") for c in small)} >= {6, 10, 14}
     assert all(any(lo <= length(programs[c]) <= hi for lo, hi in STRATA) for c in chosen)
 
 
