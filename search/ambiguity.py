@@ -25,7 +25,7 @@ from vccjax.machine.reference import RefMachine
 from vccjax.machine.scene import Scene, scenes_match
 
 
-TEMPER_NATS = 3.0  # chosen on the learning benchmark's ambiguous concepts (docs/learn.md)
+TEMPER_NATS = 3.0  # description lengths are overconfident (docs/learn.md, "Ambiguity")
 
 
 @dataclasses.dataclass(frozen=True)
