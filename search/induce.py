@@ -31,6 +31,7 @@ from search.explore import Explorer, Searcher
 from search.model import MarkovModel, Vocabulary
 from search.result import Result
 from search.task import Task
+from vccjax.records import drop_cut_tail, read_jsonl
 from vccjax.world.concepts import reference_program
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import DataFileError
@@ -122,8 +123,7 @@ class Run:
         self._write_meta(info)
         self.results_path = self.out / "results.jsonl"
         self.records = read_records(self.results_path)
-        if self.results_path.exists():
-            self.results_path.write_text("".join(json.dumps(r) + "\n" for r in self.records))
+        drop_cut_tail(self.results_path)  # never a rewrite: a kill then would lose the run
 
     @classmethod
     def view(cls, out: str | Path) -> Run:
@@ -203,18 +203,7 @@ class Run:
 def read_records(path: Path) -> list[dict]:
     """A results file's records; a last line cut by an interrupt is dropped (that concept
     is redone), any other bad line is an error."""
-    records: list[dict] = []
-    if not path.exists():
-        return records
-    lines = path.read_text().splitlines()
-    for i, line in enumerate(lines):
-        try:
-            records.append(json.loads(line))
-        except json.JSONDecodeError:
-            if i == len(lines) - 1:
-                break
-            raise DataFileError(f"{path}: line {i + 1} is not JSON") from None
-    return records
+    return read_jsonl(path)
 
 
 def _record(concept: str, it: int, r: Result, test: tuple[int, int] | None) -> dict:

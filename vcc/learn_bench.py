@@ -45,17 +45,11 @@ def _open_run(folder: Path, meta: dict) -> list[dict]:
         tmp = folder / "run.json.tmp"
         tmp.write_text(json.dumps(meta, indent=1))
         tmp.replace(path)
-    records = []
+    from vccjax.records import drop_cut_tail, read_jsonl
+
     results = folder / "results.jsonl"
-    if results.exists():
-        lines = results.read_text().splitlines()
-        for i, line in enumerate(lines):
-            try:
-                records.append(json.loads(line))
-            except json.JSONDecodeError:
-                if i != len(lines) - 1:
-                    raise DataFileError(f"{results}: line {i + 1} is not JSON") from None
-        results.write_text("".join(json.dumps(r) + "\n" for r in records))
+    records = read_jsonl(results)
+    drop_cut_tail(results)  # never a rewrite: a kill then would lose the run
     return records
 
 
