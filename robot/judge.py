@@ -7,7 +7,7 @@ is computed on the parsed scene, and the parse is first checked against the scen
 on the table (`robot.truth`): every true object seen once, shape, colour and centre
 right, so each true object's goal is known. A failure is put down to the first cause
 that holds, in this order: no scenario (none of the arm's bodies can stage the concept),
-parse error (nothing could be parsed), parse wrong, plan error, IK
+parse error (nothing could be parsed), parse wrong, plan error, non-finite state, IK
 unreachable (the tool never got within 2 cm of a target), object fell off the table,
 grasp slipped (a carried object was never lifted, or lagged the tool by 2 cm while
 carried), object dropped (lifted, then fell before its place), gripper not clear,
@@ -25,7 +25,7 @@ from robot.control import RECORD, TICK
 from robot.world import BODIES, on_table, to_table
 
 TOLERANCE = 0.02
-CAUSES = ("no scenario", "parse error", "parse wrong", "plan error", "IK unreachable", "fell off the table", "grasp slipped", "object dropped",
+CAUSES = ("no scenario", "parse error", "parse wrong", "plan error", "non-finite state", "IK unreachable", "fell off the table", "grasp slipped", "object dropped",
           "gripper not clear", "misplaced")
 
 
@@ -66,6 +66,8 @@ def _verdict(model: mujoco.MjModel, prepared, qs: np.ndarray | None) -> Verdict:
     if prepared.error is not None:
         cause = prepared.error.split(":")[0]
         return Verdict(False, cause, prepared.error, float("nan"), seed)
+    if qs is None or not np.isfinite(qs).all():  # NaN compares false: it would pass every check below
+        return Verdict(False, "non-finite state", "the rollout's state is not finite", float("nan"), seed)
     sc, expected = prepared.scenario, prepared.expected
     # each parsed object is the true object it was matched to (the parse was checked exact,
     # so every true object has one), and its goal is the program's output for it

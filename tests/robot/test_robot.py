@@ -112,6 +112,10 @@ def test_a_c_mujoco_rollout_succeeds_and_a_gripper_that_never_closes_slips(bench
     qs = c_rollout(bench.model, sc.qpos(bench.model), never, ticks, RECORD)
     bad = judge(bench.model, dataclasses.replace(prepared, keyframes=never), qs)
     assert not bad.success and bad.cause == "grasp slipped"
+    broken = qs.copy()
+    broken[-1, 0] = np.nan  # NaN compares false: without its own check it would pass as a success
+    v = judge(bench.model, prepared, broken)
+    assert not v.success and v.cause == "non-finite state"
 
 
 def test_a_scene_the_camera_cannot_parse_is_a_parse_error(bench, monkeypatch):
