@@ -9,8 +9,7 @@ table texture). Physics settings follow measured facts on this CPU
 (docs/robot.md, "MJX on CPU"): 5 ms Newton steps, 5 iterations, pyramidal cones,
 contacts only between pads, objects and the table. Friction is made 3 times stiffer
 than the normal force (`impratio`): with 1, a ball held between the flat pads crept
-down about 5 mm/s and reached the table during long carries (18 of 320 suite
-rollouts); with 3 it holds (C MuJoCo, the same 320: 318 carried out, 300 before).
+down about 5 mm/s and reached the table during long carries (docs/robot.md).
 """
 
 from __future__ import annotations
