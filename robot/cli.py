@@ -90,9 +90,6 @@ def _suite_programs(a: argparse.Namespace):
     from robot.suite import TEN
 
     programs = Programs(a.source or str(RUN_OF_RECORD))
-    # the choice is of induced concepts: the run's own, or for the reference programs (the
-    # comparison) the run of record's, so that both suites run the same concepts
-    induced = {"run": programs, "reference": None, "library": programs}[programs.source.kind]
     if a.concepts:
         names = list(TEN) if a.concepts == "ten" else [c.strip() for c in a.concepts.split(",") if c.strip()]
         names = list(dict.fromkeys(names))  # a name given twice runs once
@@ -103,7 +100,9 @@ def _suite_programs(a: argparse.Namespace):
             if why:
                 raise ValueError(f"--concepts {name}: its program {why}, not something an arm can do")
     else:
-        table = (induced or Programs(str(RUN_OF_RECORD))).table
+        # the choice is of induced concepts: for the reference programs (the comparison) the
+        # run of record's, so that both suites run the same concepts
+        table = (Programs(str(RUN_OF_RECORD)) if programs.source.kind == "reference" else programs).table
         names = sorted(arm_able(table)) if a.all or programs.source.kind == "library" else \
             default_choice(table, a.count)
         names = [c for c in names if c in programs and not not_arm_able(programs.of(c))]
@@ -168,9 +167,9 @@ def cmd_perception(a: argparse.Namespace) -> int:
               f"largest centre error {t['largest_centre_error_m'] * 1000:.1f} mm")
     record = {**runtime.provenance(f"vcc robot perception --scenes {a.scenes} --seed {a.seed} --out {a.out}"),
               "benchmark": "robot-perception", "scenes": a.scenes, "seed": a.seed, "conditions": table}
-    tmp = out.with_suffix(".tmp")
-    tmp.write_text(json.dumps(record, indent=1))
-    tmp.replace(out)
+    from robot.suite import write_record
+
+    write_record(out, record)
     print(f"-> {out}")
     return 0
 
