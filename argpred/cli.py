@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import json
 import math
 import shlex
 import subprocess
 from pathlib import Path
+
+from vccjax import runtime
 
 DEFAULT_DATA = Path.home() / ".cache" / "vccjax" / "argpred-data"
 
@@ -25,13 +26,9 @@ def _share(option: str, value: float) -> None:
 
 def _write_json(path: Path, data: dict) -> None:
     """`path`, replaced whole: a failed write leaves no cut file."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        tmp.write_text(json.dumps(data, indent=1) + "\n")
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    from vccjax import files
+
+    files.write_json(path, data)
 
 
 def _now() -> str:
@@ -184,16 +181,16 @@ def add_commands(sub) -> None:
     p = sub.add_parser("argpred", help="argument prediction: training data, training, recall on the concepts")
     s = p.add_subparsers(dest="action", required=True, metavar="ACTION")
     d = s.add_parser("data", help="draw training programs and their examples (resumable, seeded)")
-    d.add_argument("--out", required=True, help="data folder (an existing one is resumed)")
-    d.add_argument("--programs", type=int, default=1000, help="programs to draw (default 1000)")
-    d.add_argument("--seed", type=int, default=0)
-    d.add_argument("--joined", type=float, default=0.3,
+    d.add_argument("--out", required=True, type=runtime.out_folder, help="data folder (an existing one is resumed)")
+    d.add_argument("--programs", type=runtime.count(1, 10**7), default=1000, help="programs to draw (default 1000)")
+    d.add_argument("--seed", type=runtime.count(0), default=0)
+    d.add_argument("--joined", type=runtime.number(0, 1), default=0.3,
                    help="share of programs drawn as two parts joined by reset_attn (default 0.3, as the "
                         "shipped weights)")
     d.add_argument("--kind", choices=("drawn", "carry"), default="drawn",
                    help="drawn (default): programs of 3 to 6 instructions; carry: an object carried onto "
                         "another one (what `train --carry` adds)")
-    d.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")
+    d.add_argument("--workers", type=runtime.count(0, 256), default=0, help="processes (default: one per core)")
     d.add_argument("--quiet", action="store_true")
     d.set_defaults(fn=cmd_data)
 
@@ -202,45 +199,50 @@ def add_commands(sub) -> None:
                                  "optax, and write the weights (msgpack + JSON card with its sha256). "
                                  "An interrupted run resumes from OUT.ckpt. The defaults reproduce the "
                                  "shipped weights.")
-    t.add_argument("--out", default="argpred-weights.msgpack", help="weights file (default argpred-weights.msgpack)")
+    t.add_argument("--out", default="argpred-weights.msgpack", type=runtime.out_file(".msgpack"),
+                   help="weights file (default argpred-weights.msgpack)")
     t.add_argument("--data", help=f"data folder (default {DEFAULT_DATA}/seedS-N), or several built ones, "
                                   "comma-separated, to train on together")
-    t.add_argument("--programs", type=int, default=None,
+    t.add_argument("--programs", type=runtime.count(1, 10**7), default=None,
                    help="training programs (default: all of an existing --data folder, else 1000)")
-    t.add_argument("--epochs", type=int, default=30)
-    t.add_argument("--batch", type=int, default=64)
-    t.add_argument("--lr", type=float, default=3e-3, help="Adam learning rate")
-    t.add_argument("--l1", type=float, default=1e-4, help="L1 weight on the kernels")
-    t.add_argument("--positive-weight", type=float, default=16.0,
+    t.add_argument("--epochs", type=runtime.count(1, 10**5), default=30)
+    t.add_argument("--batch", type=runtime.count(1, 2**16), default=64)
+    t.add_argument("--lr", type=runtime.number(0, 10, above=True), default=3e-3, help="Adam learning rate")
+    t.add_argument("--l1", type=runtime.number(0, 10), default=1e-4, help="L1 weight on the kernels")
+    t.add_argument("--positive-weight", type=runtime.number(0, 10**4, above=True), default=16.0,
                    help="loss weight of a used argument (>1 favours recall over extra arguments)")
-    t.add_argument("--hidden", type=int, default=32, help="hidden channels (0: the paper's single convolution)")
-    t.add_argument("--joined", type=float, default=None,
+    t.add_argument("--hidden", type=runtime.count(0, 4096), default=32,
+                   help="hidden channels (0: the paper's single convolution)")
+    t.add_argument("--joined", type=runtime.number(0, 1), default=None,
                    help="share of two-part programs in newly drawn data (default: the folder's, else 0.3)")
-    t.add_argument("--kernel", type=int, default=3)
-    t.add_argument("--depth", type=int, default=1, help="hidden convolutions (with --hidden > 0)")
+    t.add_argument("--kernel", type=runtime.count(1, 15), default=3)
+    t.add_argument("--depth", type=runtime.count(1, 8), default=1, help="hidden convolutions (with --hidden > 0)")
     t.add_argument("--evidence", choices=("signed", "relu"), default="relu",
                    help="relu (default): an example adds evidence for an argument or nothing; signed: the "
                         "paper's plain sum, where examples that do not show an argument count against it")
-    t.add_argument("--bias-start", type=float, default=-4.0, help="first bias of every label under --evidence relu")
-    t.add_argument("--carry", type=int, default=30,
+    t.add_argument("--bias-start", type=runtime.number(-100, 100), default=-4.0,
+                   help="first bias of every label under --evidence relu")
+    t.add_argument("--carry", type=runtime.count(0, 10**6), default=30,
                    help="carry programs (an object carried onto another one: 10 instructions, beyond the drawn "
                         "six) added to the data, drawn into DEFAULT/seedS-carryN (default 30; 0: none)")
-    t.add_argument("--members", type=int, default=3,
+    t.add_argument("--members", type=runtime.count(1, 64), default=3,
                    help="networks trained from seeds S, S+1, ... whose probabilities are averaged (default 3)")
-    t.add_argument("--seed", type=int, default=0)
-    t.add_argument("--workers", type=int, default=0, help="processes for the data (default: one per core)")
+    t.add_argument("--seed", type=runtime.count(0), default=0)
+    t.add_argument("--workers", type=runtime.count(0, 256), default=0,
+                   help="processes for the data (default: one per core)")
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(fn=cmd_train)
 
     e = s.add_parser("eval", help="recall on the 546 concepts' training pairs; prints `recall: X` last")
     e.add_argument("--weights", help="weights file (default: the shipped weights)")
-    e.add_argument("--concepts", default="all", help="'all' (default), 'demo' or a comma-separated list")
+    e.add_argument("--concepts", type=runtime.name_list, default="all",
+                   help="'all' (default), 'demo' or a comma-separated list")
     e.add_argument("--dataset", help="dataset folder (default: the shipped one)")
-    e.add_argument("--out", "--json", dest="out",
+    e.add_argument("--out", "--json", dest="out", type=runtime.out_file(".json"),
                    help="write the result JSON here: recall, concepts recalled, misses, mean extra arguments "
                         "per function, the weights' sha256, date, commit and command")
     e.add_argument("--record", action="store_true",
                    help="also keep the recall (all concepts, shipped examples) in the weights card; the "
                         "weights file itself is not rewritten")
-    e.add_argument("--show", type=int, default=10, help="missed concepts to list (default 10)")
+    e.add_argument("--show", type=runtime.count(0), default=10, help="missed concepts to list (default 10)")
     e.set_defaults(fn=cmd_recall)

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from argpred.features import MAX_OBJECTS, scene_cells
+from vccjax import files
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import DataFileError, ProgramSyntaxError, SceneError
 from vccjax.world.pairs import TRAIN, ExampleError, distinguishes, make_pairs
@@ -276,7 +277,7 @@ def build(out: str | Path, programs: int, seed: int = 0, workers: int = 1,
     if kind == "carry" and joined:
         raise ValueError("carry programs are not joined; use joined=0 for kind 'carry'")
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    files.hold(out, "data folder")  # one builder at a time
     n = -(-programs // SHARD)
     sizes = [min(SHARD, programs - k * SHARD) for k in range(n)]
     if (out / "manifest.json").exists():
@@ -305,7 +306,7 @@ def build(out: str | Path, programs: int, seed: int = 0, workers: int = 1,
                 "labels": [list(x) for x in LABELS], "max_objects": MAX_OBJECTS,
                 "shards": {f"shard{k:04d}.npz": _sha(out / f"shard{k:04d}.npz") for k in range(n)},
                 **({"kind": kind, "programs": programs} if kind != "drawn" else {})}
-    (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
+    files.write_json(out / "manifest.json", manifest)
     return manifest
 
 
@@ -324,9 +325,8 @@ def built(folder: str | Path) -> dict | None:
 def _write_shard(job) -> None:
     out, seed, k, joined, kind, size = job
     arrays = build_shard(seed, k, size=size, joined=joined, kind=kind)
-    tmp = out / f"shard{k:04d}.tmp.npz"
-    np.savez_compressed(tmp, **arrays)
-    tmp.replace(out / f"shard{k:04d}.npz")  # whole or not at all
+    with files.whole(out / f"shard{k:04d}.npz") as tmp:  # whole or not at all
+        np.savez_compressed(tmp, **arrays)
 
 
 def _valid_shard(out: Path, seed: int, k: int, joined: float = 0.0, kind: str = "drawn", size: int = SHARD) -> bool:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -24,6 +25,7 @@ from argpred.features import features_from_cells
 from argpred.model import ArgNet
 from argpred.predict import THRESHOLD
 from argpred.weights import init_params
+from vccjax import files
 
 
 @dataclasses.dataclass(frozen=True)
@@ -119,19 +121,19 @@ def train(data: dict, settings: TrainSettings, checkpoint: str | Path | None = N
                                                      params, opt_state, jnp.asarray(x), jnp.asarray(y))
             losses.append(float(bce))
             objective.append(float(weighted))
+            if not math.isfinite(objective[-1]):  # diverged: nothing of it is kept or written
+                raise ValueError(f"training diverged at epoch {epoch + 1} (the loss is {objective[-1]}); "
+                                 "lower --lr or change the settings")
         val = evaluate(model, params, data, va, settings.batch) if len(va) else {}
         # train_loss: what Adam lowers (used labels weighted); train_bce: the plain mean
         history.append({"epoch": epoch + 1, "train_loss": float(np.mean(objective)),
                         "train_bce": float(np.mean(losses)), **val})
         bar.set_postfix(train=f"{history[-1]['train_bce']:.4f}", val=f"{val.get('val_bce', float('nan')):.4f}")
         if ckpt:
-            ckpt.parent.mkdir(parents=True, exist_ok=True)
-            tmp = ckpt.with_suffix(".tmp")
-            tmp.write_bytes(serialization.to_bytes({
+            files.write_whole(ckpt, serialization.to_bytes({
                 "epoch": epoch + 1, "params": params, "opt_state": opt_state,
                 "history": {str(k): h for k, h in enumerate(history)}, "settings": _settings_dict(settings),
                 "data": data_fingerprint(data)}))
-            tmp.replace(ckpt)
     return model, params, history
 
 

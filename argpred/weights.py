@@ -19,14 +19,17 @@ from pathlib import Path
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 from flax import serialization
 
 from argpred.data import LABELS
 from argpred.features import CHANNELS, GRID
 from argpred.model import ArgNet
+from vccjax import files
 from vccjax.errors import DataFileError
 
 FORMAT, VERSION = "vccjax-argpred-weights", 1
+MAX_HIDDEN = 4096  # the largest hidden size a card may claim
 
 
 def shipped_weights() -> Path:
@@ -60,24 +63,38 @@ def save(path: str | Path, model: ArgNet, params: dict, info: dict | None = None
              "members": members_of(params)}
     card = {"format": FORMAT, "version": VERSION, "model": shape,
             "labels": [list(x) for x in LABELS], "sha256": sha, **(info or {})}
-    _replace(path, data)
-    _write_card(path, card)
+    if not all(bool(np.isfinite(np.asarray(w)).all()) for w in jax.tree.leaves(params)):
+        raise ValueError(f"{path}: refusing to write weights that are not all finite")
+    # The card is written first under a pending name, then the weights, then the card is
+    # renamed into place: a kill in between leaves a pending card that `load` finishes.
+    files.write_whole(_pending(path), json.dumps(card, indent=1))
+    files.write_whole(path, data)
+    _pending(path).replace(path.with_suffix(".json"))
     return sha
 
 
-def _replace(path: Path, data: bytes) -> None:
-    """`path` replaced whole by `data`: a failed write leaves neither a cut file nor its temporary."""
-    tmp = path.with_name(path.name + ".tmp")
+def _pending(path: Path) -> Path:
+    return path.with_name(path.name + ".card-pending.json")
+
+
+def _finish_pending(path: Path, data: bytes) -> None:
+    """A save killed between its renames: keep the pending card if it is the weights'."""
+    pending = _pending(path)
+    if not pending.exists():
+        return
     try:
-        tmp.write_bytes(data)
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
+        sha = json.loads(pending.read_text()).get("sha256")
+    except (OSError, ValueError, AttributeError):
+        sha = None
+    if sha == hashlib.sha256(data).hexdigest():
+        pending.replace(path.with_suffix(".json"))
+    else:
+        pending.unlink(missing_ok=True)  # killed before the weights were replaced
 
 
 def _write_card(path: Path, card: dict) -> None:
     """The card beside `path`, replaced whole."""
-    _replace(path.with_suffix(".json"), json.dumps(card, indent=1).encode())
+    files.write_whole(path.with_suffix(".json"), json.dumps(card, indent=1))
 
 
 def record(path: str | Path | None = None, **fields) -> dict:
@@ -99,12 +116,15 @@ def load(path: str | Path | None = None) -> tuple[ArgNet, dict, dict]:
     path = Path(path) if path is not None else shipped_weights()
     card_path = path.with_suffix(".json")
     try:
-        card = json.loads(card_path.read_text())
         data = path.read_bytes()
+        _finish_pending(path, data)
+        card = json.loads(card_path.read_text())
     except FileNotFoundError as e:
         raise DataFileError(f"{e.filename}: missing (train with `vcc argpred train`)") from None
-    except json.JSONDecodeError as e:
-        raise DataFileError(f"{card_path}: not JSON ({e})") from None
+    except IsADirectoryError as e:
+        raise DataFileError(f"{e.filename}: a folder, not weights") from None
+    except (ValueError, RecursionError) as e:
+        raise DataFileError(f"{card_path}: not JSON ({str(e)[:80]})") from None
     if not isinstance(card, dict) or card.get("format") != FORMAT or card.get("version") != VERSION:
         raise DataFileError(f"{card_path}: not a {FORMAT} v{VERSION} card")
     if card.get("labels") != [list(x) for x in LABELS]:
@@ -116,8 +136,10 @@ def load(path: str | Path | None = None) -> tuple[ArgNet, dict, dict]:
                        depth=int(card["model"].get("depth", 1)),
                        evidence=str(card["model"].get("evidence", "signed")))
         members = int(card["model"].get("members", 1))
-        if members < 1:
-            raise ValueError(f"members {members}")
+        for name, value, low, top in (("hidden", model.hidden, 0, MAX_HIDDEN), ("kernel", model.kernel, 1, 15),
+                                      ("depth", model.depth, 1, 8), ("members", members, 1, 64)):
+            if not low <= value <= top:  # a card may not make us allocate without bound
+                raise ValueError(f"model {name} {value} outside {low}..{top}")
         template = init_params(model) if members == 1 else stack([init_params(model)] * members)
         params = serialization.from_bytes(template, data)
     except (KeyError, TypeError, ValueError, AttributeError) as e:  # AttributeError: msgpack of a number or list
@@ -125,4 +147,6 @@ def load(path: str | Path | None = None) -> tuple[ArgNet, dict, dict]:
     for a, b in zip(jax.tree.leaves(params), jax.tree.leaves(template)):
         if a.shape != b.shape:
             raise DataFileError(f"{path}: a weight of shape {a.shape} where the model has {b.shape}")
+        if not np.isfinite(np.asarray(a)).all():
+            raise DataFileError(f"{path}: holds weights that are not finite (NaN or infinity)")
     return model, params, card

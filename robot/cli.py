@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from collections import Counter
 from pathlib import Path
 
@@ -17,7 +16,7 @@ def _program(a: argparse.Namespace):
     from robot.plan import NOT_ON_A_ROBOT
     from vccjax.machine.instructions import NAMES
 
-    if a.program:
+    if a.program is not None:
         program = runtime.program_from_arg(a.program)
     else:
         from robot.sources import programs_of
@@ -66,12 +65,14 @@ def cmd_run(a: argparse.Namespace) -> int:
             n = write_frames(bench.model, scenarios[k], records[k], a.frames)
             print(f"key frames: {a.frames} ({n}, scenario {k})")
     if a.json:
-        Path(a.json).write_text(json.dumps({
+        from vccjax import files
+
+        files.write_json(a.json, {
             **runtime.provenance(f"vcc robot run --concept {a.concept} --scenarios {a.scenarios} --seed {a.seed}"),
             "concept": a.concept,
             "program": [p.text() for p in (program if isinstance(program, list) else [program])],
             "scenarios": a.scenarios, "seed": a.seed,
-            "success": ok, "timing": info, "verdicts": [v.__dict__ for v in verdicts]}, indent=1))
+            "success": ok, "timing": info, "verdicts": [v.__dict__ for v in verdicts]})
     print(f"success: {ok} of {len(verdicts)} ({ok / max(1, len(verdicts)):.1%})")
     return 0
 
@@ -202,11 +203,12 @@ def add_commands(sub) -> None:
     r.add_argument("--program", help="program text or file to run instead of the reference program")
     r.add_argument("--induced", metavar="RUN",
                    help="take the concept's program from this `vcc induce` run folder (default: the reference)")
-    r.add_argument("--scenarios", type=int, default=32, help="randomized scenarios (default 32)")
-    r.add_argument("--seed", type=int, default=0)
-    r.add_argument("--video", help="write one rollout as a video (.mp4 or .avi)")
-    r.add_argument("--frames", help="write that rollout's key frames side by side as a picture (.png or .jpg)")
-    r.add_argument("--json", help="write the full report here")
+    r.add_argument("--scenarios", type=runtime.count(1, 4096), default=32, help="randomized scenarios (default 32)")
+    r.add_argument("--seed", type=runtime.count(0), default=0)
+    r.add_argument("--video", type=runtime.out_file(".mp4", ".avi"), help="write one rollout as a video (.mp4 or .avi)")
+    r.add_argument("--frames", type=runtime.out_file(".png", ".jpg", ".jpeg"),
+                   help="write that rollout's key frames side by side as a picture (.png or .jpg)")
+    r.add_argument("--json", type=runtime.out_file(".json"), help="write the full report here")
     r.add_argument("--all-cores", action="store_true",
                    help="let XLA use every core (on a 2-core CPU this hung at 32 scenarios)")
     r.set_defaults(fn=cmd_run)
@@ -216,15 +218,18 @@ def add_commands(sub) -> None:
                                  "record induced) in randomized scenarios; one JSON per concept with a record per "
                                  "scenario. Default choice: 150 arm-able concepts stratified by program length "
                                  "(docs/robot.md).")
-    u.add_argument("--out", required=True, help="results folder (an existing one is resumed)")
+    u.add_argument("--out", required=True, type=runtime.out_folder, help="results folder (an existing one is resumed)")
     u.add_argument("--source", metavar="RUN|reference|library",
                    help="where programs come from: a `vcc induce` run folder (default: the run of record), "
                         "the shipped reference programs, or the user's library of learned concepts")
-    u.add_argument("--concepts", help="comma-separated names (A+B composes), or 'ten' for the first ten-concept suite")
+    u.add_argument("--concepts", type=runtime.name_list,
+                   help="comma-separated names (A+B composes), or 'ten' for the first ten-concept suite")
     u.add_argument("--all", action="store_true", help="every arm-able concept of the source")
-    u.add_argument("--count", type=int, default=150, help="concepts in the default stratified choice (150)")
-    u.add_argument("--scenarios", type=int, default=8, help="randomized scenarios per concept (default 8)")
-    u.add_argument("--seed", type=int, default=0)
+    u.add_argument("--count", type=runtime.count(1, 10**4), default=150,
+                   help="concepts in the default stratified choice (150)")
+    u.add_argument("--scenarios", type=runtime.count(1, 4096), default=8,
+                   help="randomized scenarios per concept (default 8)")
+    u.add_argument("--seed", type=runtime.count(0), default=0)
     u.add_argument("--shard", default="0/1", metavar="K/N",
                    help="run only every N-th concept from the K-th: N processes on one folder, one core each")
     u.add_argument("--status", action="store_true",
@@ -236,15 +241,16 @@ def add_commands(sub) -> None:
                      description="Render the suite's scenes from the top camera under nominal light, dimmer and "
                                  "brighter light, and with the camera a few millimetres and degrees off its "
                                  "calibration; parse each and check it against the objects truly on the table.")
-    c.add_argument("--out", required=True, help="result JSON")
-    c.add_argument("--scenes", type=int, default=200, help="scenes per condition (default 200)")
-    c.add_argument("--seed", type=int, default=0)
+    c.add_argument("--out", required=True, type=runtime.out_file(".json"), help="result JSON")
+    c.add_argument("--scenes", type=runtime.count(1, 10**5), default=200, help="scenes per condition (default 200)")
+    c.add_argument("--seed", type=runtime.count(0), default=0)
     c.set_defaults(fn=cmd_perception)
 
     t = s.add_parser("stress", help="many rollouts of random concepts and scenarios: no NaN, no crash (resumable)")
-    t.add_argument("--out", required=True, help="results folder (an existing one is resumed)")
-    t.add_argument("--rollouts", type=int, default=1000, help="rollouts, in whole batches of 32 (default 1000)")
-    t.add_argument("--seed", type=int, default=7)
+    t.add_argument("--out", required=True, type=runtime.out_folder, help="results folder (an existing one is resumed)")
+    t.add_argument("--rollouts", type=runtime.count(1, 10**6), default=1000,
+                   help="rollouts, in whole batches of 32 (default 1000)")
+    t.add_argument("--seed", type=runtime.count(0), default=7)
     t.add_argument("--source", metavar="RUN|reference|library",
                    help="where programs come from (default: the run of record's learned programs)")
     t.add_argument("--all-cores", action="store_true", help="let XLA use every core")

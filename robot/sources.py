@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 from pathlib import Path
 
 from vccjax.errors import DataFileError
@@ -44,14 +43,18 @@ def induced_programs(run: str | Path) -> dict[str, Program]:
     path = Path(run) / "results.jsonl"
     if not path.is_file():
         raise DataFileError(f"{path}: missing (give the folder of a `vcc induce` run)")
+    from vccjax.records import read_jsonl
+
     found = {}
-    for k, line in enumerate(path.read_text().splitlines()):
-        try:
-            r = json.loads(line)
-            if r["found"]:
+    schema = {"concept": (str,), "found": (bool,), "program": (str, None)}
+    for k, r in enumerate(read_jsonl(path, schema)):
+        if r["found"]:
+            if r["program"] is None:
+                raise DataFileError(f"{path}: line {k + 1}: a record found has no program")
+            try:
                 found[r["concept"]] = parse(r["program"])
-        except (ValueError, KeyError, TypeError) as e:
-            raise DataFileError(f"{path}: line {k + 1} is not a result of `vcc induce` ({e})") from None
+            except ValueError as e:
+                raise DataFileError(f"{path}: line {k + 1}: {e}") from None
     return found
 
 

@@ -6,7 +6,6 @@ stopped; each batch is drawn from its own seed, so a resumed run is the same run
 
 from __future__ import annotations
 
-import json
 import time
 from collections import Counter
 from pathlib import Path
@@ -14,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from robot.sources import Programs
+from vccjax import files
 
 BATCH = 32
 
@@ -51,10 +51,15 @@ def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: 
 
     from robot.judge import tally
     from robot.rollout import Bench
-    from robot.suite import finished, world_sha256, write_record
+    from robot.suite import finished, read_record, world_sha256, write_record
 
+    from robot.choice import arm_able
+    from vccjax.errors import SceneError
+
+    if not arm_able(programs.table):  # said before the progress bar starts
+        raise SceneError(f"{programs.source.path or programs.source.kind}: no concept an arm can carry out")
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    files.hold(out, "stress folder")  # one writer at a time
     batches = -(-rollouts // BATCH)
     bench = None
     for b in tqdm(range(batches), desc="robot stress", unit="batch"):
@@ -75,7 +80,8 @@ def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: 
         write_record(path, record)
         log(f"batch {b}: {record['success']} of {len(items)} carried out, "
             f"{record['non_finite']} non-finite, wall {info['wall_s']:.0f} s")
-    rows = [json.loads((out / f"batch-{b:03d}.json").read_text()) for b in range(batches)]
+    rows = [read_record(out / f"batch-{b:03d}.json", {"rolled_out": (int,), "success": (int,)})
+            for b in range(batches)]
     summary = {"seed": seed, "batches": batches, "rollouts": batches * BATCH,
                "rolled_out": sum(r["rolled_out"] for r in rows),
                "non_finite": sum(r["non_finite"] for r in rows),
@@ -83,5 +89,5 @@ def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: 
                "failures": dict(sum((Counter(r["failures"]) for r in rows), Counter())),
                "concepts": len({c for r in rows for c in r["concepts"]}),
                "wall_s": sum(r["timing"]["wall_s"] for r in rows)}
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    files.write_json(out / "summary.json", summary)
     return summary

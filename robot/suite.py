@@ -40,6 +40,15 @@ def file_of(out: Path, name: str) -> Path:
     return out / f"{name.replace('<', '').replace('>', '').replace('+', '_then_')}.json"
 
 
+def read_record(path: Path, schema: dict | None = None) -> dict:
+    """A concept's record (or another of this schema), refused by name when it is not one."""
+    from vccjax.errors import DataFileError, read_json
+    from vccjax.records import check_fields
+
+    schema = {"concept": (str,), "records": (list,)} if schema is None else schema
+    return check_fields(read_json(path, DataFileError, "missing"), schema, str(path))
+
+
 def finished(path: Path, **expected) -> bool:
     """Whether `path` holds a record made with these settings (a resume keeps it; one
     made with other settings is redone, not mixed in). A source matches on its kind and
@@ -47,7 +56,7 @@ def finished(path: Path, **expected) -> bool:
     concepts leaves this one's record good (`program_sha256` says what ran)."""
     if not path.exists():
         return False
-    record = json.loads(path.read_text())
+    record = read_record(path)
     for k, v in expected.items():
         got = record.get(k)
         if k == "source" and isinstance(got, dict):
@@ -60,11 +69,9 @@ def finished(path: Path, **expected) -> bool:
 def write_record(path: Path, record: dict) -> None:
     """Whole or not at all, if the run is killed while writing (a resume trusts it); each
     process through its own temporary file, since shards share the summary."""
-    import os
+    from vccjax import files
 
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps(record, indent=1, allow_nan=False))
-    tmp.replace(path)
+    files.write_json(path, record)
 
 
 def world_sha256() -> str:
@@ -92,8 +99,11 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
     from robot.scenario import draw
     from vccjax.errors import SceneError
 
+    from vccjax import files
+
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    files.hold(out, "suite folder" if shard == (0, 1) else f"suite shard {shard[0]}/{shard[1]}",
+               name=".vcc.lock" if shard == (0, 1) else f".vcc-shard-{shard[0]}-of-{shard[1]}.lock")
 
     def settings(name: str) -> dict:
         return _settings(programs, name, scenarios, seed)
@@ -154,7 +164,7 @@ def summarise(out: Path, programs: Programs, concepts: Sequence[str], scenarios:
     for name in concepts:
         path = file_of(out, name)
         if finished(path, **_settings(programs, name, scenarios, seed)):
-            rows.append(json.loads(path.read_text()))
+            rows.append(read_record(path))
     from robot.choice import STRATA, length, not_arm_able
 
     records = [r for row in rows for r in row["records"]]

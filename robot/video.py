@@ -10,6 +10,7 @@ import mujoco
 import numpy as np
 
 from robot.control import TICK
+from vccjax import files
 
 
 def write_video(model: mujoco.MjModel, scenario, qs: np.ndarray, path: str | Path, every: int,
@@ -24,16 +25,17 @@ def write_video(model: mujoco.MjModel, scenario, qs: np.ndarray, path: str | Pat
     scenario.dress(model, data)
     fps = 1.0 / (every * TICK)
     width = size * 16 // 9 // 2 * 2  # codecs want even sizes
-    out = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*fourcc), fps, (width, size))
-    if not out.isOpened():
-        raise OSError(f"{path}: OpenCV cannot write this video here")
-    with mujoco.Renderer(model, size, width) as r:
-        for q in qs:
-            data.qpos[:] = q
-            mujoco.mj_forward(model, data)
-            r.update_scene(data, camera=camera)
-            out.write(cv2.cvtColor(r.render(), cv2.COLOR_RGB2BGR))
-    out.release()
+    with files.whole(path) as tmp:
+        out = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*fourcc), fps, (width, size))
+        if not out.isOpened():
+            raise OSError(f"{path}: OpenCV cannot write this video here")
+        with mujoco.Renderer(model, size, width) as r:
+            for q in qs:
+                data.qpos[:] = q
+                mujoco.mj_forward(model, data)
+                r.update_scene(data, camera=camera)
+                out.write(cv2.cvtColor(r.render(), cv2.COLOR_RGB2BGR))
+        out.release()
     return len(qs)
 
 
@@ -56,6 +58,7 @@ def write_frames(model: mujoco.MjModel, scenario, qs: np.ndarray, path: str | Pa
             shots.append(r.render())
     gap = np.full((size, 4, 3), 255, np.uint8)
     strip = np.concatenate([x for s in shots for x in (s, gap)][:-1], axis=1)
-    if not cv2.imwrite(str(path), cv2.cvtColor(strip, cv2.COLOR_RGB2BGR)):
-        raise OSError(f"{path}: could not be written")
+    with files.whole(path) as tmp:
+        if not cv2.imwrite(str(tmp), cv2.cvtColor(strip, cv2.COLOR_RGB2BGR)):
+            raise OSError(f"{path}: could not be written")
     return count

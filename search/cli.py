@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
-from vccjax import runtime
+from vccjax import files, runtime
 from vccjax.world.concepts import concept_list
 
 
@@ -34,12 +33,14 @@ def cmd_induce(a: argparse.Namespace) -> int:
     runtime.prepare()
     if not a.dataset:
         ds = dataset_for(names, a.seed, a.dataset, progress=not a.quiet)
+    for c in names:  # every concept's examples read and checked before the run folder is touched
+        ds.arrays(c)
     from search.explore import Explorer
 
     run = induce(names, ds.pairs, a.out, settings, explorer=Explorer(width=a.width), progress=not a.quiet,
                  examples_sha256=ds.sha256, answers=ds.program, start=start)
     s = summary(run, names)
-    (Path(a.out) / "summary.json").write_text(json.dumps(s, indent=1))
+    files.write_json(Path(a.out) / "summary.json", s)
     print(f"{'concepts':<28}{s['concepts']}")
     print(f"{'induced':<28}{s['found']}")
     print(f"{'exact on all test pairs':<28}{s['exact_on_all_test_pairs']}")
@@ -95,11 +96,13 @@ def add_commands(sub) -> None:
                     "and repeat. Results go to OUT/results.jsonl after every concept; rerunning the same "
                     "command resumes.",
     )
-    p.add_argument("--concepts", default="all",
+    p.add_argument("--concepts", type=runtime.name_list, default="all",
                    help="'all' (default: the 546, or every concept of --dataset), 'demo' (a dozen short ones) "
                         "or a comma-separated list")
-    p.add_argument("--out", required=True, help="run folder (created; an existing one is resumed)")
-    p.add_argument("--budget", type=int, default=500_000, help="programs per concept (default 500000)")
+    p.add_argument("--out", required=True, type=runtime.out_folder,
+                   help="run folder (created; an existing one is resumed)")
+    p.add_argument("--budget", type=runtime.count(1, 10**10), default=500_000,
+                   help="programs per concept (default 500000)")
     p.add_argument("--order", type=int, choices=[0, 1], default=1, help="Markov order (default 1)")
     p.add_argument("--args", default="predicted",
                    choices=["uniform", "uniform+fixation", "oracle", "predicted", "predicted+fixation"],
@@ -108,13 +111,13 @@ def add_commands(sub) -> None:
     p.add_argument("--model", help="start from a learned model: 'library' (the shipped one), a library file, "
                                    "or a run's model-K.json; then one pass over the concepts")
     p.add_argument("--subroutines", choices=["on", "off"], default="on")
-    p.add_argument("--epsilon", type=float, default=0.1, help="pseudocount (default 0.1)")
-    p.add_argument("--iterations", type=int, default=8, help="explore-compress iterations at most")
+    p.add_argument("--epsilon", type=runtime.number(0, 1), default=0.1, help="pseudocount (default 0.1)")
+    p.add_argument("--iterations", type=runtime.count(1, 100), default=8, help="explore-compress iterations at most")
     p.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax, seed 0)")
-    p.add_argument("--seed", type=int, default=0,
+    p.add_argument("--seed", type=runtime.count(0), default=0,
                    help="examples' seed without --dataset: 0 (default) is the shipped dataset; another "
                         "builds these concepts' examples under ~/.cache/vccjax")
-    p.add_argument("--width", type=int, default=32,
+    p.add_argument("--width", type=runtime.count(1, 4096), default=32,
                    help="concepts searched in lockstep, their programs stepped in shared batches (default 32)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(fn=cmd_induce)

@@ -31,7 +31,9 @@ from search.explore import Explorer, Searcher
 from search.model import MarkovModel, Vocabulary
 from search.result import Result
 from search.task import Task
-from vccjax.records import drop_cut_tail, read_jsonl
+from vccjax import files
+from vccjax.errors import read_json
+from vccjax.records import Schema, append_line, check_fields, drop_cut_tail, read_jsonl
 from vccjax.world.concepts import reference_program
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import DataFileError
@@ -103,27 +105,38 @@ class Run:
     def __init__(self, out: str | Path, settings: Settings):
         self.out = Path(out)
         self.settings = settings
-        self.out.mkdir(parents=True, exist_ok=True)
+        files.check_writable(self.out, "run", folder=True)
+        files.hold(self.out)  # one writer per run folder
         meta = self.out / "run.json"
         mine = dataclasses.asdict(settings)
+        self.results_path = self.out / "results.jsonl"
+        # everything is read and checked before anything is written: a refused resume
+        # leaves the folder as it was
         if meta.exists():
-            try:
-                info = json.loads(meta.read_text())
-            except json.JSONDecodeError as e:
-                raise DataFileError(f"{meta}: not JSON ({e})") from None
+            info = self._meta()
             if info.get("settings") != mine:
                 raise DataFileError(
                     f"{meta}: this folder holds a run with other settings {info.get('settings')}; "
                     "use another --out or the same settings to resume"
                 )
+        elif self.out.is_dir() and any(not f.name.startswith(".") for f in self.out.iterdir()):
+            raise DataFileError(f"{self.out}: holds files but no run.json, so it is not a run to resume; "
+                                "use another --out")
         else:
             info = {"format": "vccjax-induce", "version": 1, "settings": mine}
+        self.records = read_records(self.results_path)
+        drop_cut_tail(self.results_path)  # never a rewrite: a kill then would lose the run
         info.setdefault("sessions", []).append(round(time.time(), 3))  # starts, for the wall time
         self.session = len(info["sessions"]) - 1
         self._write_meta(info)
-        self.results_path = self.out / "results.jsonl"
-        self.records = read_records(self.results_path)
-        drop_cut_tail(self.results_path)  # never a rewrite: a kill then would lose the run
+
+    def _meta(self) -> dict:
+        """run.json, checked: an object of this format with its settings and sessions."""
+        meta = self.out / "run.json"
+        info = read_json(meta, DataFileError, "no run.json in this run folder")
+        if not isinstance(info, dict) or info.get("format") != "vccjax-induce":
+            raise DataFileError(f"{meta}: not a vccjax induction run's run.json")
+        return check_fields(info, {"settings": (dict,), "sessions": (list,)}, str(meta))
 
     @classmethod
     def view(cls, out: str | Path) -> Run:
@@ -139,7 +152,7 @@ class Run:
         """Record each concept's examples hash; refuse a resume on other examples (a
         rebuilt or different dataset would mix two runs in one results file)."""
         meta = self.out / "run.json"
-        info = json.loads(meta.read_text())
+        info = self._meta()
         known = info.setdefault("examples_sha256", {})
         changed = sorted(c for c, h in hashes.items() if known.get(c, h) != h)
         if changed:
@@ -156,7 +169,7 @@ class Run:
         """Record the argument predictor's weights (sha256); refuse a resume under other
         weights, or of records whose weights were not recorded (they would mix)."""
         meta = self.out / "run.json"
-        info = json.loads(meta.read_text())
+        info = self._meta()
         known = info.get("predictor_sha256")
         if known is None and self.records:
             raise DataFileError(f"{meta}: this run's records do not say which argument-predictor weights made "
@@ -172,7 +185,7 @@ class Run:
         """Record the model the run started from ('uniform' or a learned model's hash);
         refuse a resume from another (its records would mix two starts)."""
         meta = self.out / "run.json"
-        info = json.loads(meta.read_text())
+        info = self._meta()
         known = info.get("start_model", "uniform")
         if self.records and known != name:
             raise DataFileError(f"{meta}: this run started from model {known[:12]}, not {name[:12]}; "
@@ -182,9 +195,7 @@ class Run:
             self._write_meta(info)
 
     def _write_meta(self, info: dict) -> None:
-        tmp = self.out / "run.json.tmp"
-        tmp.write_text(json.dumps(info, indent=1))
-        tmp.replace(self.out / "run.json")  # whole or not at all, if killed while writing
+        files.write_json(self.out / "run.json", info)  # whole or not at all, if killed while writing
 
     def found(self) -> dict[str, dict]:
         return {r["concept"]: r for r in self.records if r["found"]}
@@ -195,15 +206,24 @@ class Run:
     def append(self, record: dict) -> None:
         record = {**record, "session": self.session, "at": round(time.time(), 3)}
         self.records.append(record)
-        with self.results_path.open("a") as f:
-            f.write(json.dumps(record) + "\n")
-            f.flush()
+        append_line(self.results_path, record)
 
 
 def read_records(path: Path) -> list[dict]:
     """A results file's records; a last line cut by an interrupt is dropped (that concept
     is redone), any other bad line is an error."""
-    return read_jsonl(path)
+    records = read_jsonl(path, RECORD_SCHEMA)
+    for i, r in enumerate(records):
+        if r["found"] and r["program"] is None:
+            raise DataFileError(f"{path}: line {i + 1}: a record found has no program")
+    return records
+
+
+# What every results line must hold (more fields are kept as they are).
+RECORD_SCHEMA: Schema = {
+    "concept": (str,), "found": (bool,), "iteration": (int,), "program": (str, None),
+    "dl": (float, None), "nodes": (int,), "programs_run": (int,), "seconds": (float,),
+}
 
 
 def _record(concept: str, it: int, r: Result, test: tuple[int, int] | None) -> dict:
@@ -251,11 +271,11 @@ def induce(
             vocab, model = start or (Vocabulary(), MarkovModel.uniform(Vocabulary().size, settings.order))
         else:
             vocab, model = fit_model(programs, settings, subs_on)
-        (run.out / f"model-{it}.json").write_text(json.dumps({
+        files.write_json(run.out / f"model-{it}.json", {
             "iteration": it, "order": settings.order, "subroutines": vocab.to_json(),
             "tokens": [vocab.name(t) for t in range(vocab.size)] + ["<end>"],
             "logp": np.round(model.logp, 6).tolist(),
-        }))
+        }, indent=None)
         done = {r["concept"] for r in run.records if r["iteration"] == it} | set(before)
         todo = [c for c in concepts if c not in done]
         bar = tqdm(total=len(todo), desc=f"iteration {it}", disable=not progress, unit="concept")

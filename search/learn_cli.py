@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import json
 import os
 import tempfile
 from pathlib import Path
 
-from vccjax import runtime
+from vccjax import files as vfiles, runtime
 from vccjax.errors import VCCError
 
 QUERY_FILES = ("query.json", "query.png", "query_in.json")
@@ -60,7 +59,7 @@ def concept_record(learned, examples: list[tuple[str, object, object]], files: l
 
 
 def _write_json(folder: Path, name: str, content) -> None:
-    (folder / name).write_text(json.dumps(content, indent=1) + "\n")
+    vfiles.write_json(folder / name, content)
 
 
 def cmd_learn(a: argparse.Namespace) -> int:
@@ -97,6 +96,7 @@ def cmd_learn(a: argparse.Namespace) -> int:
                        "--budget, more pairs, or --fixate to point out where to look")
     record = concept_record(learned, examples, files, settings)
     out = Path(a.out)
+    vfiles.hold(out, "concept folder")  # one writer at a time
     out.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=out, prefix=".learn-") as tmp:
         tmp = Path(tmp)
@@ -201,19 +201,22 @@ def add_commands(sub) -> None:
                     "Writes OUT/concept.json and OUT/trace.png; when the pairs leave the concept ambiguous, also "
                     "OUT/query.png and OUT/query.json, a new input to answer with one more pair.")
     p.add_argument("examples", metavar="EXAMPLES", help="folder of example pairs")
-    p.add_argument("--out", required=True, help="folder for concept.json, trace.png and the query")
-    p.add_argument("--budget", type=int, default=500_000, help="programs searched at most (default 500000)")
+    p.add_argument("--out", required=True, type=runtime.out_folder,
+                   help="folder for concept.json, trace.png and the query")
+    p.add_argument("--budget", type=runtime.count(1, 10**10), default=500_000,
+                   help="programs searched at most (default 500000)")
     p.add_argument("--library", default="shipped",
                    help="'shipped' (default: learned on the 546), 'uniform' (from scratch) or a library file")
     p.add_argument("--args", choices=["predicted", "uniform"], default="predicted",
                    help="arguments: predicted by the CNN from the pairs (default) or uniform")
     p.add_argument("--fixate", help="the teacher's hint: where to look first (left, right, top, bottom, center; "
                                     "several comma-separated)")
-    p.add_argument("--rival-budget", type=int, default=2_000_000,
+    p.add_argument("--rival-budget", type=runtime.count(0, 10**10), default=2_000_000,
                    help="a second pass looks for rivals among the programs ranked up to this many past the first "
                         "fit (default 2000000; 0: none)")
-    p.add_argument("--fresh-scenes", type=int, default=100, help="scenes the rivals are compared on (default 100)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the fresh scenes (default 0)")
+    p.add_argument("--fresh-scenes", type=runtime.count(1, 10**5), default=100,
+                   help="scenes the rivals are compared on (default 100)")
+    p.add_argument("--seed", type=runtime.count(0), default=0, help="seed of the fresh scenes (default 0)")
     p.add_argument("--name", help="a name for the concept (with --save)")
     p.add_argument("--save", action="store_true",
                    help="add it to your concept library ($VCC_LIBRARY, default ~/.local/share/vccjax/concepts)")
@@ -227,9 +230,10 @@ def add_commands(sub) -> None:
     lsub = lib.add_subparsers(dest="action", required=True)
     b = lsub.add_parser("build", help="rebuild it from a finished `vcc induce` run folder")
     b.add_argument("--from", dest="source", required=True, help="the run folder (run.json, results.jsonl)")
-    b.add_argument("--out", required=True, help="library file to write (the shipped one: search/data/library.json)")
+    b.add_argument("--out", required=True, type=runtime.out_file(".json"),
+                   help="library file to write (the shipped one: search/data/library.json)")
     b.set_defaults(fn=cmd_library_build)
     s = lsub.add_parser("show", help="verify a library and summarise it")
     s.add_argument("path", nargs="?", help="library file (default: the shipped one)")
-    s.add_argument("--show", type=int, default=10, help="subroutines to list (default 10)")
+    s.add_argument("--show", type=runtime.count(0), default=10, help="subroutines to list (default 10)")
     s.set_defaults(fn=cmd_library_show)

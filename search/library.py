@@ -15,14 +15,14 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
 from search.model import MarkovModel, Vocabulary, transition_counts
-from vccjax.errors import DataFileError
+from vccjax.errors import DataFileError, read_json
+from vccjax.records import check_fields
 from vccjax.sealed import intact, seal, write_whole
 
 FORMAT = "vccjax-library"
@@ -70,13 +70,12 @@ def build(run_folder: str | Path) -> dict:
 
     folder = Path(run_folder)
     meta_path = folder / "run.json"
+    meta = read_json(meta_path, DataFileError, "missing (not an induction run folder)")
     try:
-        meta = json.loads(meta_path.read_text())
         settings = meta["settings"]
         order, epsilon, cap = int(settings["order"]), float(settings["epsilon"]), int(settings["max_subroutines"])
-    except FileNotFoundError:
-        raise DataFileError(f"{meta_path}: missing (not an induction run folder)") from None
-    except (json.JSONDecodeError, KeyError, TypeError, ValueError) as e:
+        _check_model_numbers(order, epsilon)
+    except (KeyError, TypeError, ValueError) as e:
         raise DataFileError(f"{meta_path}: not an induction run's settings ({e})") from None
     found = Run.view(folder).found()
     if not found:
@@ -103,15 +102,17 @@ def save(content: dict, path: str | Path) -> str:
     return content["content_sha256"]
 
 
+def _check_model_numbers(order: int, epsilon: float) -> None:
+    if order not in (0, 1):
+        raise ValueError(f"order {order}: 0 or 1")
+    if not 0 <= epsilon <= 1:  # NaN fails this too
+        raise ValueError(f"epsilon {epsilon}: from 0 to 1")
+
+
 def load(path: str | Path | None = None, check_predictor: bool = True) -> Library:
     """The library at `path` (default: the shipped one), verified."""
     path = Path(path) if path is not None else shipped_library()
-    try:
-        content = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise DataFileError(f"{path}: missing") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise DataFileError(f"{path}: not a readable JSON file ({e})") from None
+    content = read_json(path, DataFileError, "missing")
     if not isinstance(content, dict) or content.get("format") != FORMAT:
         raise DataFileError(f"{path}: not a {FORMAT} file")
     if content.get("version") != VERSION:
@@ -123,9 +124,12 @@ def load(path: str | Path | None = None, check_predictor: bool = True) -> Librar
         vocab = Vocabulary.from_json(content["subroutines"])
         order, epsilon = int(content["order"]), float(content["epsilon"])
         counts = np.zeros((vocab.size + 1, vocab.size + 1))
+        _check_model_numbers(order, epsilon)
         for i, j, n in content["transitions"]:
+            if not (isinstance(n, int) and n >= 0 and 0 <= i <= vocab.size and 0 <= j <= vocab.size):
+                raise ValueError(f"transition {[i, j, n]}: counts are whole numbers of at least 0 between tokens")
             counts[i, j] = n
-        card = dict(content["card"])
+        card = check_fields(content["card"], {"settings": (dict,), "concepts": (list,)}, f"{path}: card")
     except (KeyError, TypeError, ValueError, IndexError) as e:
         raise DataFileError(f"{path}: malformed library ({e})") from None
     if check_predictor:

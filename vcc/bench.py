@@ -5,17 +5,16 @@ stamped with the date, commit, machine and the exact command."""
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from collections import Counter
 from pathlib import Path
+
+from vccjax import files, runtime
 
 
 def stamp(a: argparse.Namespace, benchmark: str) -> dict:
     """Where and when a measurement was made, and the command that made it (rebuilt from the
     parsed settings, so a bench called from Python is stamped as truly as one from the shell)."""
-    from vccjax import runtime
-
     return runtime.provenance(command_line(a, benchmark))
 
 
@@ -91,8 +90,7 @@ def cmd_bench_search(a: argparse.Namespace) -> int:
         "scalar": rates(scalar, scalar_s), "results_agree": agree,
         "ratio": round(scalar_s / jax_s, 2),
     }
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(a.out).write_text(json.dumps(report, indent=1))
+    files.write_json(a.out, report)
     b, s = report["batched"], report["scalar"]
     print(f"{len(names)} concepts, budget {a.budget}, {a.model} model, oracle arguments; "
           f"{report['found']} found by both: {'same programs' if agree else 'RESULTS DIFFER'}")
@@ -146,8 +144,7 @@ def cmd_bench_emulator(a: argparse.Namespace) -> int:
               "stream": {"programs": len(stream), "per_concept": a.per_concept, "record_seconds": round(record_s, 2),
                          "instructions": dict(ops.most_common())},
               "main": main, "sweeps": sweeps}
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(a.out).write_text(json.dumps(report, indent=1))
+    files.write_json(a.out, report)
     every = [main] + sweeps["batch"][1:] + sweeps["objects"] + sweeps["raster"]
     agree = all(m["agree"] for m in every)
     print(f"{len(stream)} programs from the search of {len(names)} concepts ({len(ops)} instructions), "
@@ -206,10 +203,10 @@ def _write_report(a: argparse.Namespace, runs: Path) -> int:
     st = stamp(a, "reproduce")
     rows = report.collect_rows(runs)
     out = Path(a.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({**st, "benchmark": "reproduce", "runs": str(runs), "rows": rows}, indent=1))
-    report.write(out.parent, rows, Path(a.report), st, Path(a.others) if a.others else None,
-                 Path(a.robot) if a.robot else None)
+    text = report.render(out.parent, rows, st, Path(a.others) if a.others else None,
+                         Path(a.robot) if a.robot else None, runs)  # all read and checked first
+    files.write_json(out, {**st, "benchmark": "reproduce", "runs": str(runs), "rows": rows})
+    files.write_whole(a.report, text)
     print(f"{len(rows)} row runs -> {out}; report -> {a.report}")
     return 0
 
@@ -220,9 +217,10 @@ def cmd_bench_report(a: argparse.Namespace) -> int:
 
 def _report_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument("--runs", default="benchmarks/reproduce", help="row run folders (default benchmarks/reproduce)")
-    p.add_argument("--out", default="benchmarks/results/reproduce.json",
+    p.add_argument("--out", default="benchmarks/results/reproduce.json", type=runtime.out_file(".json"),
                    help="results JSON; the report reads every result JSON beside it")
-    p.add_argument("--report", default="benchmarks/REPORT.md", help="the generated report")
+    p.add_argument("--report", default="benchmarks/REPORT.md", type=runtime.out_file(".md"),
+                   help="the generated report")
     p.add_argument("--others", default="benchmarks/induction",
                    help="committed induction runs to list apart (default benchmarks/induction; '' for none)")
     p.add_argument("--robot", default="benchmarks/robot",
@@ -230,8 +228,10 @@ def _report_flags(p: argparse.ArgumentParser) -> None:
 
 
 def _concept_flags(p: argparse.ArgumentParser, sample: int) -> None:
-    p.add_argument("--concepts", help="comma-separated concepts (default: --sample spread over all 546)")
-    p.add_argument("--sample", type=int, default=sample, help=f"concepts, evenly spread (default {sample})")
+    p.add_argument("--concepts", type=runtime.name_list,
+                   help="comma-separated concepts (default: --sample spread over all 546)")
+    p.add_argument("--sample", type=runtime.count(1, 10**4), default=sample,
+                   help=f"concepts, evenly spread (default {sample})")
     p.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
 
 
@@ -244,12 +244,14 @@ def add_commands(sub) -> None:
                                     "interpreter; print programs/s (counted as the paper counts them) "
                                     "and the ratio. Compile time is measured apart (a first run).")
     _concept_flags(s, 64)
-    s.add_argument("--budget", type=int, default=100_000, help="programs per concept (default 100000)")
+    s.add_argument("--budget", type=runtime.count(1, 10**10), default=100_000,
+                   help="programs per concept (default 100000)")
     s.add_argument("--model", choices=["uniform", "reference"], default="uniform",
                    help="uniform: explore-compress iteration 0; reference: an order-1 model fitted "
                         "on the reference programs, standing in for a late iteration (deeper trees)")
-    s.add_argument("--width", type=int, default=32, help="concepts in lockstep (default 32)")
-    s.add_argument("--out", default="benchmarks/results/search.json", help="result JSON")
+    s.add_argument("--width", type=runtime.count(1, 4096), default=32, help="concepts in lockstep (default 32)")
+    s.add_argument("--out", default="benchmarks/results/search.json", type=runtime.out_file(".json"),
+                   help="result JSON")
     s.set_defaults(fn=cmd_bench_search)
     e = bsub.add_parser("emulator", help="batched JAX emulator vs reference interpreter on a search's stream",
                         description="Record the children a real search steps (the scalar-driven search of "
@@ -258,25 +260,29 @@ def add_commands(sub) -> None:
                                     "per instruction and overall, and their ratio in the same run. Sweeps over "
                                     "batch size, objects per scene and raster size; compile time apart.")
     _concept_flags(e, 16)
-    e.add_argument("--per-concept", type=int, default=500, help="children recorded per concept (default 500)")
-    e.add_argument("--batch", default="1024,4096", help="rows per device call; the first is the main one")
-    e.add_argument("--objects", default="2,5,8", help="objects per random scene for the objects sweep")
-    e.add_argument("--raster", default="32,128", help="raster sizes for the raster sweep (the default is 64)")
-    e.add_argument("--repeats", type=int, default=3, help="timed passes (the best is kept)")
-    e.add_argument("--out", default="benchmarks/results/emulator.json", help="result JSON")
+    e.add_argument("--per-concept", type=runtime.count(1, 10**6), default=500,
+                   help="children recorded per concept (default 500)")
+    e.add_argument("--batch", default="1024,4096", type=runtime.counts(1, 2**16), help="rows per device call; the first is the main one")
+    e.add_argument("--objects", default="2,5,8", type=runtime.counts(1, 10), help="objects per random scene for the objects sweep")
+    e.add_argument("--raster", default="32,128", type=runtime.counts(8, 512), help="raster sizes for the raster sweep (the default is 64)")
+    e.add_argument("--repeats", type=runtime.count(1, 100), default=3, help="timed passes (the best is kept)")
+    e.add_argument("--out", default="benchmarks/results/emulator.json", type=runtime.out_file(".json"),
+                   help="result JSON")
     e.set_defaults(fn=cmd_bench_emulator)
     r = bsub.add_parser("reproduce", help="the paper's induction experiments as rows beside its figures",
                         description="Run the paper's experiments (budgets, order 0/1, arguments uniform/"
                                     "predicted/predicted+fixation, the learning curve) as explore-compress "
                                     "runs, one folder per row under --runs; rerunning resumes. Then write "
                                     "the results JSON and benchmarks/REPORT.md (rows not run say so).")
-    r.add_argument("--rows", default="all", help="comma-separated rows, 'all' (default) or 'none' (report only)")
+    r.add_argument("--rows", default="all", type=runtime.name_list, help="comma-separated rows, 'all' (default) or 'none' (report only)")
     r.add_argument("--list", action="store_true", help="list the rows and the paper's figures, run nothing")
-    r.add_argument("--concepts", default="all", help="'all' (default), 'demo' or a comma-separated list")
-    r.add_argument("--scale", type=float, default=1.0,
+    r.add_argument("--concepts", type=runtime.name_list, default="all",
+                   help="'all' (default), 'demo' or a comma-separated list")
+    r.add_argument("--scale", type=runtime.number(0, 1, above=True), default=1.0,
                    help="multiply every row's budget (a tiny CI run; the folder name says so)")
     r.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
-    r.add_argument("--width", type=int, default=32, help="concepts searched in lockstep (default 32)")
+    r.add_argument("--width", type=runtime.count(1, 4096), default=32,
+                   help="concepts searched in lockstep (default 32)")
     r.add_argument("--quiet", action="store_true", help="no progress bars")
     _report_flags(r)
     r.set_defaults(fn=cmd_bench_reproduce)

@@ -20,7 +20,7 @@ from vccjax import runtime
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = runtime.Parser(
         prog="vcc",
         description="Visual Cognitive Computer toolkit: run cognitive programs on tabletop scenes "
                     "and induce them from examples.",

@@ -22,9 +22,13 @@ import json
 import time
 from pathlib import Path
 
-from vccjax.errors import DataFileError
+from vccjax.errors import DataFileError, read_json
+from vccjax import runtime
+from vccjax.records import append_line
 
 STARTS = ("library", "uniform")
+# What every results line must hold (the key of `_key`, and whether it was found).
+RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 
 
 def _key(r: dict) -> tuple:
@@ -34,21 +38,21 @@ def _key(r: dict) -> tuple:
 def _open_run(folder: Path, meta: dict) -> list[dict]:
     """The records of an earlier session of this run (a last line cut by an interrupt is
     dropped); a folder made with other settings is refused."""
-    folder.mkdir(parents=True, exist_ok=True)
+    from vccjax import files
+    from vccjax.records import drop_cut_tail, read_jsonl
+
+    files.check_writable(folder, "run", folder=True)
+    files.hold(folder)  # one writer per run folder
     path = folder / "run.json"
     if path.exists():
-        old = json.loads(path.read_text())
+        old = read_json(path, DataFileError, "no run.json")
         if old != meta:
             raise DataFileError(f"{path}: this folder holds a run with other settings, programs or examples; "
                                 "use another --run or the same settings to resume")
     else:
-        tmp = folder / "run.json.tmp"
-        tmp.write_text(json.dumps(meta, indent=1))
-        tmp.replace(path)
-    from vccjax.records import drop_cut_tail, read_jsonl
-
+        files.write_json(path, meta)
     results = folder / "results.jsonl"
-    records = read_jsonl(results)
+    records = read_jsonl(results, RECORD_SCHEMA)
     drop_cut_tail(results)  # never a rewrite: a kill then would lose the run
     return records
 
@@ -58,7 +62,6 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     from search.induce import generalization
     from search.learn import LearnSettings, chain_for, learn, model_for
     from search.task import Task
-    from vccjax import runtime
     from vccjax.machine.config import DEFAULT_CONFIG
     from vccjax.world.concepts import read_programs
     from vccjax.world.dataset import build_dataset, Dataset, rival_warnings
@@ -69,6 +72,15 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     programs = read_programs(a.programs)
     runtime.prepare()
     run = Path(a.run)
+    asking = LearnSettings(budget=a.budget)
+    head = {"budget": a.budget, "examples": examples, "ask_examples": a.ask_examples,
+            "ask_settings": dataclasses.asdict(asking),
+            "programs_sha256": hashlib.sha256(Path(a.programs).read_bytes()).hexdigest()}
+    if (run / "run.json").exists():  # a run of other settings is refused before examples are built into it
+        old = read_json(run / "run.json", DataFileError, "missing")
+        if not isinstance(old, dict) or any(old.get(k) != v for k, v in head.items()):
+            raise DataFileError(f"{run / 'run.json'}: this folder holds a run with other settings or programs; "
+                                "use another --run or the same settings to resume")
     data = Path(a.dataset) if a.dataset else run / "examples"
     for line in rival_warnings(build_dataset(data, seed=0, programs=programs, progress=not a.quiet)):
         print(line)
@@ -77,11 +89,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     if failed:
         raise DataFileError(f"{data}: no examples could be made for {', '.join(failed)}")
     names = list(programs)
-    asking = LearnSettings(budget=a.budget)
-    meta = {"budget": a.budget, "examples": examples, "ask_examples": a.ask_examples,
-            "ask_settings": dataclasses.asdict(asking),
-            "programs_sha256": hashlib.sha256(Path(a.programs).read_bytes()).hexdigest(),
-            "examples_sha256": {c: ds.sha256(c) for c in names}}
+    meta = {**head, "examples_sha256": {c: ds.sha256(c) for c in names}}
     records = _open_run(run, meta)
     done = {_key(r) for r in records}
     tau = DEFAULT_CONFIG.tau
@@ -90,8 +98,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
 
     def write(record: dict) -> None:
         records.append(record)
-        with (run / "results.jsonl").open("a") as f:
-            f.write(json.dumps(record) + "\n")
+        append_line(run / "results.jsonl", record)
 
     # learning: every concept, examples and start, in lockstep (rivals are not needed here)
     for k in examples:
@@ -205,10 +212,10 @@ def learn_timing(a: argparse.Namespace, ds, names: list[str], programs: dict) ->
 def _write_summary(a: argparse.Namespace, summary: dict, timing: dict | None, run: Path) -> None:
     from vcc.bench import stamp
 
-    out = Path(a.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
+    from vccjax import files
+
     report = {**stamp(a, "learn"), "benchmark": "learn", "run": str(run), **summary, "timing": timing}
-    out.write_text(json.dumps(report, indent=1) + "\n")
+    files.write_json(a.out, report)
     print(f"{'':28}{'found':>8}{'right':>8}   (of {summary['concepts']} new concepts; right: all 50 test pairs)")
     for label, row in summary["learn"].items():
         print(f"{label:28}{row['found']:>8}{row['right']:>8}")
@@ -233,12 +240,13 @@ def add_command(bsub) -> None:
                                     "Resumable: rerun the same command.")
     p.add_argument("--programs", default="benchmarks/learn/concepts.txt", help="`name: program` lines")
     p.add_argument("--dataset", help="their built examples (default: built under RUN/examples)")
-    p.add_argument("--run", default="benchmarks/learn/run", help="run folder (results.jsonl, resumable)")
-    p.add_argument("--budget", type=int, default=500_000, help="programs per search (default 500000)")
-    p.add_argument("--examples", default="10,3", help="examples per concept for the learning rows")
-    p.add_argument("--ask-examples", type=int, default=2, help="examples per concept for the asking rows")
-    p.add_argument("--width", type=int, default=32, help="concepts searched in lockstep (default 32)")
+    p.add_argument("--run", default="benchmarks/learn/run", type=runtime.out_folder,
+                   help="run folder (results.jsonl, resumable)")
+    p.add_argument("--budget", type=runtime.count(1, 10**10), default=500_000, help="programs per search (default 500000)")
+    p.add_argument("--examples", default="10,3", type=runtime.counts(1, 10), help="examples per concept for the learning rows")
+    p.add_argument("--ask-examples", type=runtime.count(1, 10), default=2, help="examples per concept for the asking rows")
+    p.add_argument("--width", type=runtime.count(1, 4096), default=32, help="concepts searched in lockstep (default 32)")
     p.add_argument("--timing", action="store_true", help="also time vcc learn cold and warm (two processes)")
     p.add_argument("--quiet", action="store_true")
-    p.add_argument("--out", default="benchmarks/results/learn.json", help="result JSON")
+    p.add_argument("--out", default="benchmarks/results/learn.json", type=runtime.out_file(".json"), help="result JSON")
     p.set_defaults(fn=cmd_bench_learn)

@@ -7,6 +7,8 @@ import json
 from pathlib import Path
 
 from vcc import reproduce as rp
+from vccjax import files
+from vccjax.errors import DataFileError
 
 TARGETS = {"emulator": 20.0, "search": 25_000, "main_wall_s": 2 * 3600, "main_found": 526, "stretch": 540}
 
@@ -227,24 +229,47 @@ def collect_rows(runs: Path) -> dict[str, dict]:
     out = {}
     if runs.exists():
         for path in sorted(p for p in runs.iterdir() if p.is_dir()):
-            s = rp.read_row(path)
+            try:
+                s = rp.read_row(path)
+            except DataFileError:
+                raise
+            except (TypeError, AttributeError, KeyError, IndexError, ValueError) as e:
+                raise DataFileError(f"{path}: not a run the report can read ({type(e).__name__}: "
+                                    f"{str(e)[:80]})") from None
             if s is not None:
                 out[path.name] = s
     return out
 
 
-def write(results_dir: Path, rows: dict[str, dict], out: Path, stamp: dict, others: Path | None = None,
-          robot: Path | None = None) -> str:
-    """`rows`: what `collect_rows` read (the caller writes them to the results JSON too)."""
+def render(results_dir: Path, rows: dict[str, dict], stamp: dict, others: Path | None = None,
+           robot: Path | None = None, runs: Path | None = None) -> str:
+    """The report's text; a result file, row or run of the wrong shape is named in one
+    error line (nothing is written before the whole text is made)."""
     results = _load(results_dir)
     lines = ["# vccjax benchmark report", "",
              f"Generated {stamp['date']} at commit {stamp['commit']} by `{stamp['command']}` on "
              f"{stamp['machine']['cores']} cores ({stamp['machine']['cpu']}), JAX {stamp['machine']['jax']}. "
              f"Only measured numbers: each table names its result file or run folder.", ""]
-    lines += targets_section(results, rows) + emulator_section(results) + search_section(results)
-    lines += reproduce_section(rows) + (other_runs_section(others) if others else [])
-    lines += (robot_section(robot) if robot else []) + camera_section(results)
-    text = "\n".join(lines)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text)
+    for section, source in ((lambda: targets_section(results, rows), f"{results_dir} or {runs}"),
+                            (lambda: emulator_section(results), results_dir),
+                            (lambda: search_section(results), results_dir),
+                            (lambda: reproduce_section(rows), runs),
+                            (lambda: other_runs_section(others) if others else [], others),
+                            (lambda: robot_section(robot) if robot else [], robot),
+                            (lambda: camera_section(results), results_dir)):
+        try:
+            lines += section()
+        except DataFileError:
+            raise
+        except (TypeError, AttributeError, KeyError, IndexError, ValueError) as e:
+            raise DataFileError(f"{source}: a result there is not of the shape the report reads "
+                                f"({type(e).__name__}: {str(e)[:80]})") from None
+    return "\n".join(lines)
+
+
+def write(results_dir: Path, rows: dict[str, dict], out: Path, stamp: dict, others: Path | None = None,
+          robot: Path | None = None) -> str:
+    """`rows`: what `collect_rows` read (the caller writes them to the results JSON too)."""
+    text = render(results_dir, rows, stamp, others, robot)
+    files.write_whole(out, text)
     return text

@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from search.induce import Settings
+from vccjax import files
 
 MAIN = "o1-predfix-0.5M"  # the headline run: order 1, predicted + fixation, 0.5M
 
@@ -110,7 +111,7 @@ def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset:
     run = induce(names, pairs, out, scaled(row, scale), explorer=Explorer(width=width), progress=progress,
                  examples_sha256=lambda c: f"{ds.sha256(c)}:first{row.examples}")
     s = {**summary(run, names), "complete": True, "concepts_list": names}
-    (out / "summary.json").write_text(json.dumps(s, indent=1))
+    files.write_json(out / "summary.json", s)
     return s
 
 

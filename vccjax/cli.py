@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vccjax import runtime
+from vccjax import files, runtime
 from vccjax.errors import VCCError
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.views.text import ascii_scene, legend
@@ -171,8 +171,12 @@ def cmd_perception_evaluate(a: argparse.Namespace) -> int:
     if unknown or not styles:
         raise VCCError(f"--styles {a.styles}: each must be one of {', '.join(RENDERED + DRAWN)}")
     sizes = [int(s) for s in str(a.size).split(",")]
-    if min(sizes) < 64:
-        raise VCCError(f"--size {a.size}: images of at least 64 pixels")
+    if a.dataset:  # every file checked before the first progress bar
+        from vccjax.world.dataset import Dataset
+
+        ds = Dataset(a.dataset)
+        for name in ds.concepts:
+            ds.arrays(name)
     results = []
     for style in styles:
         for size in sizes:
@@ -192,13 +196,13 @@ def cmd_perception_evaluate(a: argparse.Namespace) -> int:
         Path(a.out).parent.mkdir(parents=True, exist_ok=True)
         command = (f"vcc perception eval --styles {a.styles} --size {a.size} --images {a.images} --seed {a.seed}"
                    + " --touching" * a.touching + " --pointer-on-object" * a.pointer_on_object)
-        Path(a.out).write_text(json.dumps({"command": command, "results": results}, indent=1))
+        files.write_json(a.out, {"command": command, "results": results})
     return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The emulator's commands alone (the full `vcc` adds the other packages': vcc.cli)."""
-    p = argparse.ArgumentParser(
+    p = runtime.Parser(
         prog="vcc",
         description="Visual Cognitive Computer toolkit: run cognitive programs on tabletop scenes.",
     )
@@ -211,12 +215,14 @@ def _scene_flags(p: argparse.ArgumentParser) -> None:
     p.add_argument("--concept", metavar="NAME", help="one of the 546 concepts (see `vcc concepts`)")
     p.add_argument("--scene", metavar="FILE", help="scene JSON file")
     p.add_argument("--image", metavar="FILE", help="image file of a scene, parsed by the OpenCV perception")
-    p.add_argument("--example", type=int, metavar="K",
+    p.add_argument("--example", type=runtime.count(0), metavar="K",
                    help="the concept's K-th example pair: its input, checked against its output")
     p.add_argument("--split", choices=["train", "test"], default="train", help="pairs of --example (default train)")
     p.add_argument("--dataset", metavar="DIR", help="built dataset folder for --example (default: the shipped one)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the random scene when none is given (default 0)")
-    p.add_argument("--objects", type=int, default=4, help="objects in the random scene (default 4)")
+    p.add_argument("--seed", type=runtime.count(0), default=0,
+                   help="seed of the random scene when none is given (default 0)")
+    p.add_argument("--objects", type=runtime.count(1, DEFAULT_CONFIG.n_max), default=4,
+                   help="objects in the random scene (default 4)")
 
 
 def add_commands(sub) -> None:
@@ -235,20 +241,25 @@ def add_commands(sub) -> None:
                                    "attention (filters, attended list, the attended object boxed), and "
                                    "the instruction with its argument; a failure is marked in red.")
     _scene_flags(t)
-    t.add_argument("--out", required=True, help="trace.png (a sheet of panels) or trace.gif (animated); "
+    t.add_argument("--out", required=True, type=runtime.out_file(".png", ".gif", several=True),
+                   help="trace.png (a sheet of panels) or trace.gif (animated); "
                                                 "both, comma-separated")
-    t.add_argument("--size", type=int, default=256, help="panel width in pixels (default 256)")
-    t.add_argument("--columns", type=int, default=6, help="panels per row of the PNG sheet (default 6)")
-    t.add_argument("--seconds", type=float, default=0.8, help="seconds per GIF frame (default 0.8)")
+    t.add_argument("--size", type=runtime.count(32, 2048), default=256, help="panel width in pixels (default 256)")
+    t.add_argument("--columns", type=runtime.count(1, 64), default=6,
+                   help="panels per row of the PNG sheet (default 6)")
+    t.add_argument("--seconds", type=runtime.number(0, 60, above=True), default=0.8,
+                   help="seconds per GIF frame (default 0.8)")
     t.set_defaults(fn=cmd_trace)
     d = sub.add_parser("dataset", help="build or check the concepts' example pairs")
     dsub = d.add_subparsers(dest="action", required=True, metavar="ACTION")
     b = dsub.add_parser("build", help="generate 10 training and 50 test pairs per concept (resumable)")
-    b.add_argument("--concepts", default="all", help="'all' (default) or a comma-separated list")
+    b.add_argument("--concepts", type=runtime.name_list, default="all",
+                   help="'all' (default) or a comma-separated list")
     b.add_argument("--programs", help="build your own concepts instead: a file of `name: program` lines")
-    b.add_argument("--seed", type=int, default=0, help="seed (default 0); same seed, same bytes")
-    b.add_argument("--out", default="data/examples", help="output folder (default data/examples)")
-    b.add_argument("--workers", type=int, default=0, help="processes (default: one per core)")
+    b.add_argument("--seed", type=runtime.count(0), default=0, help="seed (default 0); same seed, same bytes")
+    b.add_argument("--out", default="data/examples", type=runtime.out_folder,
+                   help="output folder (default data/examples)")
+    b.add_argument("--workers", type=runtime.count(0, 256), default=0, help="processes (default: one per core)")
     b.set_defaults(fn=cmd_dataset_build)
     i = dsub.add_parser("info", help="verify a built dataset and summarise it")
     i.add_argument("folder")
@@ -263,18 +274,18 @@ def add_commands(sub) -> None:
     ev.add_argument("--styles", default="schematic,varied",
                     help="comma-separated: schematic, varied (our renderer); outline, jitter, photo, shades "
                          "(drawn apart from it, scored as scenes parsed exactly)")
-    ev.add_argument("--images", type=int, default=5000, help="scenes per style (default 5000)")
-    ev.add_argument("--seed", type=int, default=0)
-    ev.add_argument("--size", default="384", help="image size in pixels, or several comma-separated (default 384)")
-    ev.add_argument("--out", help="also write the results to this JSON file")
+    ev.add_argument("--images", type=runtime.count(1, 10**6), default=5000, help="scenes per style (default 5000)")
+    ev.add_argument("--seed", type=runtime.count(0), default=0)
+    ev.add_argument("--size", default="384", type=runtime.counts(64, 4096), help="image size in pixels, or several comma-separated (default 384)")
+    ev.add_argument("--out", type=runtime.out_file(".json"), help="also write the results to this JSON file")
     ev.add_argument("--dataset", help="a built dataset folder: run the end-to-end check instead")
     ev.add_argument("--touching", action="store_true",
                     help="scenes holding two touching objects of one colour, scored as scenes parsed exactly")
     ev.add_argument("--pointer-on-object", action="store_true",
                     help="every pointer on an object (as attend_pointer examples draw it), scored as scenes "
                          "parsed exactly")
-    ev.add_argument("--pairs", type=int, default=50, help="test pairs per concept (end to end)")
-    ev.add_argument("--workers", type=int, default=1, help="processes for the end-to-end check")
+    ev.add_argument("--pairs", type=runtime.count(1, 50), default=50, help="test pairs per concept (end to end)")
+    ev.add_argument("--workers", type=runtime.count(1, 256), default=1, help="processes for the end-to-end check")
     ev.set_defaults(fn=cmd_perception_evaluate)
     c = sub.add_parser("concepts", help="list the 546 concepts with their program lengths")
     c.add_argument("pattern", nargs="?", help="only names containing this")

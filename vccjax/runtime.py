@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import math
 import os
 import sys
 from collections.abc import Callable, Sequence
@@ -73,11 +74,151 @@ def error_line(e: BaseException) -> str:
     return str(e) or type(e).__name__
 
 
+def count(low: int = 1, high: int | None = None) -> Callable[[str], int]:
+    """An argparse type: a whole number from `low` to `high`, checked when the command
+    line is read (before any work)."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(
+                f"{value} is out of range: give {low} or more" if high is None else
+                f"{value} is out of range: give {low} to {high}")
+        return value
+    parse.__name__ = "whole number"
+    return parse
+
+
+def counts(low: int = 1, high: int | None = None) -> Callable[[str], str]:
+    """An argparse type: comma-separated whole numbers from `low` to `high`, at least one
+    (kept as the text, which the command splits)."""
+    one = count(low, high)
+
+    def parse(text: str) -> str:
+        items = [t.strip() for t in text.split(",")]
+        if not text.strip() or any(not t for t in items):
+            raise argparse.ArgumentTypeError(f"'{text}' has an empty item; give numbers separated by commas")
+        for t in items:
+            one(t)
+        return ",".join(items)
+    parse.__name__ = "list of whole numbers"
+    return parse
+
+
+def number(low: float | None = None, high: float | None = None, above: bool = False) -> Callable[[str], float]:
+    """An argparse type: a finite number from `low` (or above it, when `above`) to `high`."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a number") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{text} is not a finite number")
+        too_low = low is not None and (value <= low if above else value < low)
+        if too_low or (high is not None and value > high):
+            lo = "" if low is None else (f"above {low:g}" if above else f"at least {low:g}")
+            hi = "" if high is None else f"at most {high:g}"
+            bounds = " and ".join(x for x in (lo, hi) if x)
+            raise argparse.ArgumentTypeError(f"{value:g} is out of range: give a number {bounds}")
+        return value
+    parse.__name__ = "number"
+    return parse
+
+
+def name_list(text: str) -> str:
+    """An argparse type: a comma-separated list of names, none empty; a name given twice
+    is kept once (in its first place)."""
+    items = [t.strip() for t in text.split(",")]
+    if not text.strip() or any(not t for t in items):
+        raise argparse.ArgumentTypeError(f"'{text}' has an empty name; give names separated by commas")
+    return ",".join(dict.fromkeys(items))
+
+
+name_list.__name__ = "list of names"
+
+
+def out_file(*suffixes: str, several: bool = False) -> Callable[[str], str]:
+    """An argparse type: a file to write (or, with `several`, files separated by commas),
+    of one of `suffixes` (any when none), whose folder can be written: checked when the
+    command line is read, not after the work."""
+    def parse(text: str) -> str:
+        names = text.split(",") if several else [text]
+        if not all(n.strip() for n in names):
+            raise argparse.ArgumentTypeError(f"'{text}' has an empty file name")
+        for name in names:
+            if suffixes and Path(name).suffix.lower() not in suffixes:
+                raise argparse.ArgumentTypeError(f"{name}: write {' or '.join(suffixes)}")
+            _writable(name, folder=False)
+        return text
+    parse.__name__ = "output file"
+    return parse
+
+
+def out_folder(text: str) -> str:
+    """An argparse type: a folder to write (made if missing), checked when the command
+    line is read."""
+    return _writable(text, folder=True)
+
+
+out_folder.__name__ = "output folder"
+
+
+def _writable(text: str, folder: bool) -> str:
+    from vccjax import files
+
+    try:
+        files.check_writable(text, "output", folder=folder)
+    except VCCError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+    return text
+
+
+class _StoreOnce(argparse._StoreAction):
+    """An option that takes one value refuses a second (`--seed 1 --seed 2` is a slip,
+    not a choice of the last)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        if option_string is not None:
+            given = namespace.__dict__.setdefault(_GIVEN, set())
+            if self.dest in given:
+                parser.error(f"{'/'.join(self.option_strings)} given twice; give it once")
+            given.add(self.dest)
+        super().__call__(parser, namespace, values, option_string)
+
+
+_GIVEN = "_options_given"
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (what is wrong, and where to read
+    more), exit status 2, and whose single-valued options may be given once; every
+    subcommand's parser is of this class too."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
+
+    def parse_known_args(self, args=None, namespace=None):
+        parsed, rest = super().parse_known_args(args, namespace)
+        parsed.__dict__.pop(_GIVEN, None)
+        return parsed, rest
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def run_command(parser: argparse.ArgumentParser, argv: list[str] | None = None,
                 prog: str = "vcc") -> int:
-    """Parse, run the chosen command (`args.fn`), and turn user errors and Ctrl-C into
-    one line on stderr and a non-zero exit status."""
-    args = parser.parse_args(argv)
+    """Parse, run the chosen command (`args.fn`), and end every failure in one line on
+    stderr: bad input or a file that cannot be used (exit 2), Ctrl-C (130), and anything
+    else as a bug whose traceback is saved to a file the line names (exit 70)."""
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as e:  # a bad option (one line already printed), or --help
+        return int(e.code or 0) if isinstance(e.code, int) or e.code is None else 2
     fn: Callable[[argparse.Namespace], int] = args.fn
     try:
         return int(fn(args) or 0)
@@ -85,8 +226,36 @@ def run_command(parser: argparse.ArgumentParser, argv: list[str] | None = None,
         print(f"{prog}: error: {error_line(e)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
+        print(f"{prog}: interrupted; rerun the same command to resume", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader went away (`vcc concepts | head`): nothing to say
+        sys.stderr.close()
+        return 0
+    except MemoryError:
+        print(f"{prog}: error: out of memory; try smaller sizes or counts", file=sys.stderr)
+        return 2
+    except Exception as e:  # noqa: BLE001 - the last resort: one line, the traceback kept
+        print(f"{prog}: internal error (a bug, please report it): {type(e).__name__}: {str(e)[:200]}; "
+              f"traceback saved to {save_traceback()}", file=sys.stderr)
+        return 70
+
+
+def save_traceback() -> str:
+    """Write the current exception's traceback to a file and return its path."""
+    import tempfile
+    import time
+    import traceback
+
+    text = traceback.format_exc()
+    for where in (Path.home() / ".cache" / "vccjax" / "crashes", Path(tempfile.gettempdir())):
+        try:
+            where.mkdir(parents=True, exist_ok=True)
+            path = where / f"vcc-crash-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.txt"
+            path.write_text(text)
+            return str(path)
+        except OSError:
+            continue
+    return "nowhere (no writable folder)"
 
 
 def program_from_arg(text: str):
@@ -100,7 +269,14 @@ def program_from_arg(text: str):
     if path is not None and (text.endswith((".vcc", ".txt")) or path.is_file()):
         if not path.is_file():
             raise VCCError(f"{path}: no such program file")
-        text = path.read_text()
+        try:
+            text = path.read_text()
+        except UnicodeDecodeError:
+            raise VCCError(f"{path}: not a text file (a program is text)") from None
+        try:
+            return parse(text, body_max=DEFAULT_CONFIG.body_max)
+        except VCCError as e:
+            raise type(e)(f"{path}: {e}") from None
     return parse(text, body_max=DEFAULT_CONFIG.body_max)
 
 

@@ -26,7 +26,6 @@ def intact(content: dict) -> bool:
 
 def write_whole(path: Path, content: dict) -> None:
     """Write JSON through a temporary file replaced at once: never half a file."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(content, indent=1, sort_keys=True) + "\n")
-    tmp.replace(path)
+    from vccjax import files
+
+    files.write_json(path, content, sort_keys=True)

@@ -307,7 +307,7 @@ def test_shipped_weights_recall_what_their_card_records(tmp_path, capsys):
 
 def _one_error_line(capsys, fragment: str) -> None:
     err = capsys.readouterr().err
-    assert err.startswith("vcc: error: ") and err.count("\n") == 1 and fragment in err, err
+    assert err.startswith("vcc") and ": error: " in err and err.count("\n") == 1 and fragment in err, err
 
 
 def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_path, capsys, monkeypatch):
@@ -318,24 +318,24 @@ def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_pat
     w, d, res = tmp_path / "new.msgpack", tmp_path / "data", tmp_path / "r.json"
     train = ["argpred", "train", "--out", str(w), "--quiet"]
     for argv, fragment in [
-        (train + ["--epochs", "0"], "--epochs must be at least 1, got 0"),
-        (train + ["--lr", "nan"], "--lr must be a positive number, got nan"),
-        (train + ["--lr", "-0.1"], "--lr must be a positive number, got -0.1"),
-        (train + ["--positive-weight", "inf"], "--positive-weight must be a positive number, got inf"),
-        (train + ["--l1", "-1"], "--l1 must be 0 or a positive number"),
-        (train + ["--members", "0"], "--members must be at least 1"),
-        (train + ["--batch", "0"], "--batch must be at least 1"),
-        (train + ["--programs", "0"], "--programs must be at least 1"),
-        (train + ["--joined", "1.5"], "--joined must be a share from 0 to 1, got 1.5"),
-        (train + ["--carry", "-1"], "--carry must be 0 or more"),
-        (["argpred", "train", "--out", str(tmp_path), "--quiet"], "a folder; give the weights file"),
-        (["argpred", "data", "--out", str(d), "--programs", "0"], "--programs must be at least 1"),
-        (["argpred", "data", "--out", str(d), "--joined", "nan"], "--joined must be a share from 0 to 1, got nan"),
-        (["argpred", "eval", "--concepts", "", "--out", str(res)], "names no concept"),
+        (train + ["--epochs", "0"], "argument --epochs: 0 is out of range"),
+        (train + ["--lr", "nan"], "argument --lr: nan is not a finite number"),
+        (train + ["--lr", "-0.1"], "argument --lr: -0.1 is out of range"),
+        (train + ["--positive-weight", "inf"], "argument --positive-weight: inf is not a finite number"),
+        (train + ["--l1", "-1"], "argument --l1: -1 is out of range"),
+        (train + ["--members", "0"], "argument --members: 0 is out of range"),
+        (train + ["--batch", "0"], "argument --batch: 0 is out of range"),
+        (train + ["--programs", "0"], "argument --programs: 0 is out of range"),
+        (train + ["--joined", "1.5"], "argument --joined: 1.5 is out of range"),
+        (train + ["--carry", "-1"], "argument --carry: -1 is out of range"),
+        (["argpred", "train", "--out", str(tmp_path), "--quiet"], "write .msgpack"),
+        (["argpred", "data", "--out", str(d), "--programs", "0"], "argument --programs: 0 is out of range"),
+        (["argpred", "data", "--out", str(d), "--joined", "nan"], "argument --joined: nan is not a finite number"),
+        (["argpred", "eval", "--concepts", "", "--out", str(res)], "has an empty name"),
         (["argpred", "eval", "--concepts", "no_such", "--out", str(res)], "unknown concept(s): no_such"),
-        (["argpred", "eval", "--show", "-1", "--out", str(res)], "--show must be 0 or more"),
+        (["argpred", "eval", "--show", "-1", "--out", str(res)], "argument --show: -1 is out of range"),
         (["argpred", "eval", "--record", "--concepts", "remove_bottom_obj"], "--record keeps the recall on all"),
-        (["argpred", "eval", "--weights", str(tmp_path / "none.msgpack"), "--out", str(res)], "none.json: missing"),
+        (["argpred", "eval", "--weights", str(tmp_path / "none.msgpack"), "--out", str(res)], "none.msgpack: missing"),
     ]:
         assert main(argv) == 2, argv
         _one_error_line(capsys, fragment)
@@ -399,3 +399,21 @@ def test_induce_with_predicted_arguments(tmp_path, capsys, monkeypatch):
     assert main(argv) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["found"] == 2 and summary["exact_on_all_test_pairs"] == 2
+
+
+def test_training_that_diverges_stops_and_writes_no_checkpoint(tiny, tmp_path, monkeypatch):
+    """A non-finite loss (here forced) ends training with one clear error; nothing of the
+    diverged weights is kept."""
+    import argpred.train as tr
+
+    real = tr._step
+
+    def diverged(*args):
+        params, opt_state, bce, weighted = real(*args)
+        return params, opt_state, bce, float("nan")
+
+    monkeypatch.setattr(tr, "_step", diverged)
+    ckpt = tmp_path / "c.ckpt"
+    with pytest.raises(ValueError, match="training diverged at epoch 1"):
+        train(argdata.load(tiny), TrainSettings(hidden=8, epochs=2, batch=8), checkpoint=ckpt, progress=False)
+    assert not ckpt.exists()

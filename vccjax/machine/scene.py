@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import json
 from pathlib import Path
 
 import numpy as np
@@ -28,12 +27,21 @@ class SceneObject:
         if self.color not in COLORS:
             raise SceneError(f"unknown color {self.color!r}; expected one of {list(COLORS)}")
         for name in ("x", "y", "width"):
-            v = getattr(self, name)
-            if not isinstance(v, (int, float, np.floating, np.integer)) or not np.isfinite(v):
-                raise SceneError(f"object {name} must be a finite number, got {v!r}")
+            if not _finite_number(getattr(self, name)):
+                raise SceneError(f"object {name} must be a finite number, got {str(getattr(self, name))[:40]}")
 
     def describe(self) -> str:
         return f"{self.color} {self.shape} at ({self.x:.3f}, {self.y:.3f}) width {self.width:.3f}"
+
+
+def _finite_number(v) -> bool:
+    """A real number (not a boolean) that a float holds finitely: JSON allows 400 digits."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+        return False
+    try:
+        return bool(np.isfinite(float(v)))
+    except OverflowError:
+        return False
 
 
 @dataclasses.dataclass(frozen=True)
@@ -96,12 +104,15 @@ class Scene:
             except SceneError as e:
                 raise SceneError(f"{where}: object {i}: {e}") from None
         ptr = d.get("pointer")
-        if ptr is not None and (not isinstance(ptr, (list, tuple)) or len(ptr) != 2):
-            raise SceneError(f"{where}: pointer must be [x, y]")
+        if ptr is not None and (not isinstance(ptr, (list, tuple)) or len(ptr) != 2
+                                or not all(_finite_number(v) for v in ptr)):
+            raise SceneError(f"{where}: pointer must be [x, y], two finite numbers")
         return cls(tuple(objs), None if ptr is None else (float(ptr[0]), float(ptr[1])))
 
     def save(self, path: str | Path) -> None:
-        Path(path).write_text(json.dumps(self.to_dict(), indent=1))
+        from vccjax import files
+
+        files.write_json(path, self.to_dict())
 
     @classmethod
     def load(cls, path: str | Path) -> Scene:

@@ -36,7 +36,10 @@ def query_sheet(scene: Scene, outputs: Sequence[tuple[str, str, Scene | None]], 
 
 def write_query(path: str | Path, scene: Scene, outputs: Sequence[tuple[str, str, Scene | None]],
                 size: int = 256) -> Path:
+    from vccjax import files
+
     path = Path(path)
-    if not cv2.imwrite(str(path), cv2.cvtColor(query_sheet(scene, outputs, size), cv2.COLOR_RGB2BGR)):
-        raise OSError(f"{path}: could not be written")
+    with files.whole(path) as tmp:
+        if not cv2.imwrite(str(tmp), cv2.cvtColor(query_sheet(scene, outputs, size), cv2.COLOR_RGB2BGR)):
+            raise OSError(f"{path}: could not be written")
     return path

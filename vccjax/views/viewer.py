@@ -155,14 +155,17 @@ def write_trace(frames: Sequence[Frame], path: str | Path, size: int = 256, colu
         raise ValueError(f"{path}: a trace is written as .png or .gif")
     if not frames:
         raise ValueError("no frames to draw")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    from vccjax import files
+
     if suffix == ".png":
-        if not cv2.imwrite(str(path), cv2.cvtColor(sheet(frames, size, columns), cv2.COLOR_RGB2BGR)):
-            raise OSError(f"{path}: could not be written")
+        with files.whole(path) as tmp:
+            if not cv2.imwrite(str(tmp), cv2.cvtColor(sheet(frames, size, columns), cv2.COLOR_RGB2BGR)):
+                raise OSError(f"{path}: could not be written")
         return path
     from PIL import Image  # Pillow: OpenCV writes no GIF
 
     images = [Image.fromarray(panel(f, size)) for f in frames]
     durations = [int(seconds_per_step * 1000)] * (len(images) - 1) + [int(seconds_per_step * 3000)]
-    images[0].save(path, save_all=True, append_images=images[1:], duration=durations, loop=0, optimize=True)
+    with files.whole(path) as tmp:
+        images[0].save(tmp, save_all=True, append_images=images[1:], duration=durations, loop=0, optimize=True)
     return path

@@ -27,6 +27,9 @@ PAIR_FILE = re.compile(r"^(?P<key>.+)_(?P<side>in|out)\.(?P<ext>json|png|jpg|jpe
 IMAGE_EXTS = ("png", "jpg", "jpeg")
 
 
+MAX_SIDE = 8192  # pixels a side: a scene is parsed at a few hundred
+
+
 def read_image(path: str | Path) -> np.ndarray:
     """An image file as RGB uint8, or a one-line error naming the file."""
     import cv2
@@ -34,9 +37,14 @@ def read_image(path: str | Path) -> np.ndarray:
     path = Path(path)
     if not path.is_file():
         raise VCCError(f"{path}: no such image file")
-    img = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    try:
+        img = cv2.imread(str(path), cv2.IMREAD_COLOR)
+    except cv2.error as e:  # e.g. a header claiming more pixels than OpenCV will allocate
+        raise VCCError(f"{path}: an image OpenCV refuses ({str(e).strip().splitlines()[-1][:100]})") from None
     if img is None:
         raise VCCError(f"{path}: not an image OpenCV can read")
+    if max(img.shape[:2]) > MAX_SIDE:
+        raise VCCError(f"{path}: an image of {img.shape[1]}x{img.shape[0]} pixels; at most {MAX_SIDE} a side")
     return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
 
 

@@ -84,6 +84,8 @@ def read_programs(path) -> dict[str, Program]:
     from vccjax.machine.program import parse
 
     path = Path(path)
+    if path.exists() and not path.is_file():  # a folder, or a pipe that would block the read
+        raise DataFileError(f"{path}: not a regular file; give a programs file")
     try:
         lines = path.read_text().splitlines()
     except FileNotFoundError:

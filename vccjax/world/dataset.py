@@ -16,16 +16,17 @@ from __future__ import annotations
 
 import hashlib
 import io
-import json
 import zipfile
 from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
 
+from vccjax import files
 from vccjax.world.concepts import concept_names, reference_program
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.errors import DataFileError, read_json
+from vccjax.records import check_fields
 from vccjax.world.pairs import TEST, TRAIN, TRAIN_WIDE, WIDE_PATIENCE, ExampleError, discriminate, make_pairs
 from vccjax.machine.instructions import COLORS, SHAPES
 from vccjax.world.rivals import rival_programs
@@ -64,6 +65,33 @@ def arrays_to_scenes(objs: np.ndarray, ptr: np.ndarray) -> list[Scene]:
     return out
 
 
+def check_content(arrays: dict[str, np.ndarray], path: Path) -> None:
+    """Refuse a concept file whose hash is right but whose scenes are not scenes (a file
+    made by another program): every split's objects and pointers of the right shape,
+    flags 0 or 1, shape and colour indices in range, and places on the unit square."""
+    for split in ("train", "test"):
+        for side in ("in", "out"):
+            key = f"{split}_{side}"
+            objs, ptr = arrays.get(key), arrays.get(f"{key}_pointer")
+            if objs is None or ptr is None:
+                raise DataFileError(f"{path}: lacks the arrays {key} and {key}_pointer")
+            if objs.ndim != 3 or objs.shape[2] != _FIELDS or ptr.shape != (len(objs), 3):
+                raise DataFileError(f"{path}: {key} has shape {objs.shape} (pointer {ptr.shape}), "
+                                    f"expected (pairs, objects, {_FIELDS}) and (pairs, 3)")
+            if not (np.isfinite(objs).all() and np.isfinite(ptr).all()):
+                raise DataFileError(f"{path}: {key} holds values that are not finite")
+            live = objs[objs[..., 0] == 1]
+            if not np.isin(objs[..., 0], (0, 1)).all() or not np.isin(ptr[:, 0], (0, 1)).all():
+                raise DataFileError(f"{path}: {key} has object or pointer flags other than 0 and 1")
+            for col, names in ((1, SHAPES), (2, COLORS)):
+                if not np.isin(live[:, col], np.arange(len(names))).all():
+                    raise DataFileError(f"{path}: {key} has a {'shape' if col == 1 else 'colour'} index "
+                                        f"outside 0..{len(names) - 1}")
+            places = np.concatenate([live[:, 3:5].ravel(), ptr[ptr[:, 0] == 1][:, 1:].ravel()])
+            if not ((places >= 0) & (places <= 1)).all() or not ((live[:, 5] > 0) & (live[:, 5] <= 1)).all():
+                raise DataFileError(f"{path}: {key} places an object or pointer off the unit square")
+
+
 # ---- deterministic NPZ with a content hash ----------------------------------------------
 def _content_hash(arrays: dict[str, np.ndarray]) -> str:
     h = hashlib.sha256()
@@ -90,9 +118,7 @@ def write_npz(path: Path, arrays: dict[str, np.ndarray]) -> str:
             np.lib.format.write_array(member, np.ascontiguousarray(arrays[key]), allow_pickle=False)
             z.writestr(info, member.getvalue())
     data = buf.getvalue()
-    tmp = path.with_suffix(".tmp")
-    tmp.write_bytes(data)
-    tmp.replace(path)  # atomic: an interrupted build never leaves half a file
+    files.write_whole(path, data)  # an interrupted build never leaves half a file
     return hashlib.sha256(data).hexdigest()
 
 
@@ -169,8 +195,8 @@ def _build_one(job: tuple[str, str, int, VCCConfig, str]) -> tuple[str, str, str
             if (int(a["format_version"][0]) == VERSION and int(a["seed"][0]) == seed
                     and bytes(a["concept"]).decode() == name and bytes(a["program"]).decode() == text):
                 return name, hashlib.sha256(path.read_bytes()).hexdigest(), None, _lines(a["train_rivals_left"])
-        except DataFileError:
-            pass
+        except (DataFileError, KeyError, IndexError, ValueError, OSError, zipfile.BadZipFile):
+            pass  # damaged or foreign: built again
     try:
         arrays = build_concept(name, parse(text), seed, cfg)
     except ExampleError as e:
@@ -207,19 +233,38 @@ def build_dataset(
             if missing:
                 raise DataFileError(f"not in the programs given: {', '.join(missing[:5])}")
         texts = {n: programs[n].text() for n in (programs if concepts is None else concepts)}
-    out.mkdir(parents=True, exist_ok=True)
+    files.check_writable(out, "dataset", folder=True)
+    files.hold(out, "dataset folder")  # one builder at a time
+    head = {"format": FORMAT, "version": VERSION, "seed": seed,
+            "config": {"raster": cfg.raster, "n_max": cfg.n_max},
+            "splits": {"train": vars_of(TRAIN), "train_wide": vars_of(TRAIN_WIDE), "test": vars_of(TEST)}}
+    kept = _kept_entries(out, head, set(texts))
     jobs = [(n, text, seed, cfg, str(out)) for n, text in texts.items()]
     results = map_with_progress(_build_one, jobs, workers, 4, "concepts", progress, unit="concept")
     manifest = {
-        "format": FORMAT, "version": VERSION, "seed": seed,
-        "config": {"raster": cfg.raster, "n_max": cfg.n_max},
-        "splits": {"train": vars_of(TRAIN), "train_wide": vars_of(TRAIN_WIDE), "test": vars_of(TEST)},
-        "concepts": {n: {"file": file_name(n), "sha256": h} for n, h, err, _ in results if not err},
-        "failed": {n: err for n, _, err, _ in results if err},
-        "rivals_left": {n: left for n, _, err, left in results if left and not err},
+        **head,
+        "concepts": {**kept["concepts"],
+                     **{n: {"file": file_name(n), "sha256": h} for n, h, err, _ in results if not err}},
+        "failed": {**kept["failed"], **{n: err for n, _, err, _ in results if err}},
+        "rivals_left": {**kept["rivals_left"], **{n: left for n, _, err, left in results if left and not err}},
     }
-    (out / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True))
+    files.write_json(out / "manifest.json", manifest, sort_keys=True)
     return manifest
+
+
+def _kept_entries(out: Path, head: dict, rebuilt: set[str]) -> dict:
+    """What an existing manifest in `out` says of the concepts not built now: a build of
+    some concepts into a dataset folder adds to it and never drops the others. A folder
+    holding a dataset of another seed or world is refused rather than mixed."""
+    path = out / "manifest.json"
+    empty = {"concepts": {}, "failed": {}, "rivals_left": {}}
+    if not path.exists():
+        return empty
+    old = Dataset(out).manifest
+    if {k: old.get(k) for k in head} != head:
+        raise DataFileError(f"{path}: this folder holds a dataset of another seed, world or format; "
+                            "use another --out")
+    return {k: {n: v for n, v in old.get(k, {}).items() if n not in rebuilt} for k in empty}
 
 
 def rival_warnings(manifest: dict) -> list[str]:
@@ -271,6 +316,16 @@ class Dataset:
             raise DataFileError(f"{path}: not a {FORMAT} manifest")
         if manifest.get("version") != VERSION:
             raise DataFileError(f"{path}: format version {manifest.get('version')}, this vccjax reads {VERSION}")
+        concepts = manifest.get("concepts")
+        if not isinstance(concepts, dict) or not (concepts or manifest.get("failed")):
+            raise DataFileError(f"{path}: 'concepts' must be a non-empty object of concept entries")
+        for name, entry in concepts.items():
+            check_fields(entry, {"file": (str,), "sha256": (str,)}, f"{path}: concept {name}")
+            if Path(entry["file"]).name != entry["file"]:
+                raise DataFileError(f"{path}: concept {name}: its file must lie in the dataset folder")
+        for key in ("failed", "rivals_left"):
+            if not isinstance(manifest.get(key, {}), dict):
+                raise DataFileError(f"{path}: '{key}' must be an object")
         self.manifest = manifest
         self._cache: dict[str, dict[str, np.ndarray]] = {}
 
@@ -289,10 +344,14 @@ class Dataset:
             if hashlib.sha256(path.read_bytes()).hexdigest() != entry["sha256"]:
                 raise DataFileError(f"{path}: sha256 differs from the manifest (corrupt or replaced)")
             arrays = read_npz(path)
+            lacking = sorted({"format_version", "seed", "concept", "program"} - set(arrays))
+            if lacking:
+                raise DataFileError(f"{path}: lacks the arrays {', '.join(lacking)} (not a concept file)")
             if int(arrays["format_version"][0]) != VERSION:
                 raise DataFileError(f"{path}: format version {int(arrays['format_version'][0])}")
             if bytes(arrays["concept"]).decode() != concept:
                 raise DataFileError(f"{path}: holds concept {bytes(arrays['concept']).decode()!r}, not {concept!r}")
+            check_content(arrays, path)
             self._cache[concept] = arrays
         return self._cache[concept]
 

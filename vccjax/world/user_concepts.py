@@ -9,12 +9,12 @@ reported, plus the sha256 of that content: an edited or foreign file is refused 
 
 from __future__ import annotations
 
-import json
 import os
 import re
 from pathlib import Path
 
-from vccjax.errors import DataFileError, VCCError
+from vccjax.errors import DataFileError, VCCError, read_json
+from vccjax.records import check_fields
 from vccjax.machine.program import Program, parse
 from vccjax.sealed import intact, seal, write_whole
 
@@ -63,16 +63,18 @@ def load_concept(name: str, folder: Path | None = None) -> dict:
     path = folder / f"{name}.json"
     if not NAME.match(name) or not path.is_file():
         raise KeyError(f"unknown concept {name!r}: not one of the 546 and not in your library {folder}")
-    try:
-        content = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise DataFileError(f"{path}: not a readable JSON file ({e})") from None
+    content = read_json(path, DataFileError, "missing")
     if not isinstance(content, dict) or content.get("format") != FORMAT:
         raise DataFileError(f"{path}: not a {FORMAT} file")
     if content.get("version") != VERSION:
         raise DataFileError(f"{path}: concept format version {content.get('version')}, this vccjax reads {VERSION}")
     if not intact(content) or content.get("name") != name:
         raise DataFileError(f"{path}: content sha256 mismatch (edited or corrupt)")
+    check_fields(content, {"program": (str,)}, str(path))
+    try:
+        parse(content["program"])
+    except ValueError as e:
+        raise DataFileError(f"{path}: its program does not parse ({e})") from None
     return content
 
 
