@@ -72,6 +72,10 @@ def cmd_learn(a: argparse.Namespace) -> int:
         raise VCCError("--save needs --name NAME (the name to run the concept by)")
     if a.name:
         check_name(a.name)
+    if a.save:  # where it will be saved can be written: checked before the search, not after
+        from vccjax.world.user_concepts import library_folder
+
+        vfiles.check_writable(library_folder(), "concept library", folder=True)
     examples = read_pairs(a.examples)  # every pair read and checked before any search
     files = [f"{p.name}:{hashlib.sha256(p.read_bytes()).hexdigest()[:16]}"
              for _, fin, fout in pair_files(a.examples) for p in (fin, fout)]

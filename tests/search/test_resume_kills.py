@@ -11,6 +11,8 @@ from __future__ import annotations
 import json
 import os
 import signal
+import time
+import warnings
 
 import numpy as np
 import pytest
@@ -57,7 +59,11 @@ def _resume(folder, kill_at: int | None, rng: np.random.Generator) -> None:
 
 
 def _fork_resume(folder, kill_at: int | None, seed: int) -> int:
-    pid = os.fork()
+    """Fork (a fresh interpreter would spend seconds importing JAX for each resume); the
+    child touches no JAX, only files."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # JAX's warning about fork and its threads
+        pid = os.fork()
     if pid == 0:  # the child never returns into pytest
         code = 0
         try:
@@ -65,8 +71,14 @@ def _fork_resume(folder, kill_at: int | None, seed: int) -> int:
         except BaseException:
             code = 1
         os._exit(code)
-    _, status = os.waitpid(pid, 0)
-    return status
+    for _ in range(600):  # a forked child of a threaded parent could deadlock: never wait forever
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            return status
+        time.sleep(0.1)
+    os.kill(pid, signal.SIGKILL)
+    os.waitpid(pid, 0)
+    raise AssertionError("a resume did not end within 60 s")
 
 
 @pytest.mark.parametrize("kills", [8, pytest.param(20, marks=pytest.mark.slow)])

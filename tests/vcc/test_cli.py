@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 from vcc.cli import main
 
@@ -70,14 +71,14 @@ def test_scene_sources_and_their_mistakes_are_one_line_errors(capsys, tmp_path):
         (["run", "--concept", "swap_locations", "--example", "0", "--dataset", str(bad)], f"{f}: sha256 differs"),
         (["run", "--concept", "swap_locations", "--example", "0", "--dataset", str(notjson)], "manifest.json"),
         (["dataset", "info", str(bad)], "c000.npz: missing"),
-        (["trace", "--concept", "swap_locations", "--out", "t.jpg"], "write a .png sheet or a .gif animation"),
+        (["trace", "--concept", "swap_locations", "--out", "t.jpg"], "t.jpg: write .png or .gif"),
         (["trace", "scene_parse; fixate(up)", "--out", "t.png"], "argument must be one of"),
         (["trace", "--concept", "no_such_concept", "--out", "t.png"], "unknown concept 'no_such_concept'"),
     ]
     for argv, message in cases:
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
-        assert err.startswith("vcc: error: ") and message in err and err.count("\n") == 1, (argv, err)
+        assert err.startswith("vcc") and ": error: " in err and message in err and err.count("\n") == 1, (argv, err)
 
 
 def test_perception_eval_reports_json(capsys):
@@ -85,3 +86,41 @@ def test_perception_eval_reports_json(capsys):
     line = capsys.readouterr().out.strip().splitlines()[-1]
     report = json.loads(line)
     assert report["images"] == 3 and 0 <= report["recovered"] <= 1
+
+
+def test_a_bug_is_one_line_naming_where_its_traceback_was_saved(capsys, monkeypatch, tmp_path):
+    import argparse
+
+    from vccjax import runtime
+
+    monkeypatch.setenv("HOME", str(tmp_path))
+
+    def broken(a):
+        raise RuntimeError("something impossible")
+
+    parser = runtime.Parser(prog="vcc")
+    parser.set_defaults(fn=broken)
+    assert runtime.run_command(parser, []) == 70
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "internal error (a bug" in err and "RuntimeError: something impossible" in err
+    saved = Path(err.rsplit("traceback saved to ", 1)[1].strip())
+    assert saved.is_file() and "Traceback" in saved.read_text() and "something impossible" in saved.read_text()
+    assert isinstance(parser, argparse.ArgumentParser)
+
+
+def test_ctrl_c_is_one_line_and_exit_130(capsys):
+    from vccjax import runtime
+
+    def interrupted(a):
+        raise KeyboardInterrupt
+
+    parser = runtime.Parser(prog="vcc")
+    parser.set_defaults(fn=interrupted)
+    assert runtime.run_command(parser, []) == 130
+    assert capsys.readouterr().err == "vcc: interrupted; rerun the same command to resume\n"
+
+
+def test_an_option_given_twice_is_refused_in_one_line(capsys):
+    assert main(["run", "scene_parse", "--seed", "1", "--seed", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--seed given twice" in err
