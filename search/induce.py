@@ -222,7 +222,7 @@ def read_records(path: Path) -> list[dict]:
 # What every results line must hold (more fields are kept as they are).
 RECORD_SCHEMA: Schema = {
     "concept": (str,), "found": (bool,), "iteration": (int,), "program": (str, None),
-    "dl": (float, None), "nodes": (int,), "programs_run": (int,), "seconds": (float,),
+    "dl?": (float, None), "nodes?": (int,), "programs_run?": (int,), "seconds?": (float,),
 }
 
 

@@ -262,9 +262,12 @@ def add_commands(sub) -> None:
     _concept_flags(e, 16)
     e.add_argument("--per-concept", type=runtime.count(1, 10**6), default=500,
                    help="children recorded per concept (default 500)")
-    e.add_argument("--batch", default="1024,4096", type=runtime.counts(1, 2**16), help="rows per device call; the first is the main one")
-    e.add_argument("--objects", default="2,5,8", type=runtime.counts(1, 10), help="objects per random scene for the objects sweep")
-    e.add_argument("--raster", default="32,128", type=runtime.counts(8, 512), help="raster sizes for the raster sweep (the default is 64)")
+    e.add_argument("--batch", default="1024,4096", type=runtime.counts(1, 2**16),
+                   help="rows per device call; the first is the main one")
+    e.add_argument("--objects", default="2,5,8", type=runtime.counts(1, 10, none_ok=True),
+                   help="objects per random scene for the objects sweep")
+    e.add_argument("--raster", default="32,128", type=runtime.counts(8, 512, none_ok=True),
+                   help="raster sizes for the raster sweep (the default is 64)")
     e.add_argument("--repeats", type=runtime.count(1, 100), default=3, help="timed passes (the best is kept)")
     e.add_argument("--out", default="benchmarks/results/emulator.json", type=runtime.out_file(".json"),
                    help="result JSON")
@@ -274,7 +277,8 @@ def add_commands(sub) -> None:
                                     "predicted/predicted+fixation, the learning curve) as explore-compress "
                                     "runs, one folder per row under --runs; rerunning resumes. Then write "
                                     "the results JSON and benchmarks/REPORT.md (rows not run say so).")
-    r.add_argument("--rows", default="all", type=runtime.name_list, help="comma-separated rows, 'all' (default) or 'none' (report only)")
+    r.add_argument("--rows", default="all", type=runtime.name_list,
+                   help="comma-separated rows, 'all' (default) or 'none' (report only)")
     r.add_argument("--list", action="store_true", help="list the rows and the paper's figures, run nothing")
     r.add_argument("--concepts", type=runtime.name_list, default="all",
                    help="'all' (default), 'demo' or a comma-separated list")

@@ -18,6 +18,7 @@ from vccjax.errors import DataFileError, loads
 
 # A schema maps a field to the types its value may have (`None` for null); an `int`
 # field refuses booleans and a `float` field takes ints too, but never NaN or infinity.
+# A field named with a trailing `?` may be missing (when present, it has those types).
 Schema = dict[str, tuple]
 
 
@@ -27,7 +28,11 @@ def check_fields(record, schema: Schema, where: str) -> dict:
     if not isinstance(record, dict):
         raise DataFileError(f"{where}: a record must be a JSON object, not {type(record).__name__}")
     for field, kinds in schema.items():
+        optional = field.endswith("?")
+        field = field.rstrip("?")
         if field not in record:
+            if optional:
+                continue
             raise DataFileError(f"{where}: field '{field}' is missing")
         if not _has_type(record[field], kinds):
             names = "/".join("null" if k is None else k.__name__ for k in kinds)

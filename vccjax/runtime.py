@@ -91,12 +91,15 @@ def count(low: int = 1, high: int | None = None) -> Callable[[str], int]:
     return parse
 
 
-def counts(low: int = 1, high: int | None = None) -> Callable[[str], str]:
+def counts(low: int = 1, high: int | None = None, none_ok: bool = False) -> Callable[[str], str]:
     """An argparse type: comma-separated whole numbers from `low` to `high`, at least one
-    (kept as the text, which the command splits)."""
+    unless `none_ok` (an empty text then means none); kept as the text, which the command
+    splits."""
     one = count(low, high)
 
     def parse(text: str) -> str:
+        if none_ok and text == "":
+            return text
         items = [t.strip() for t in text.split(",")]
         if not text.strip() or any(not t for t in items):
             raise argparse.ArgumentTypeError(f"'{text}' has an empty item; give numbers separated by commas")

@@ -415,5 +415,5 @@ def test_training_that_diverges_stops_and_writes_no_checkpoint(tiny, tmp_path, m
     monkeypatch.setattr(tr, "_step", diverged)
     ckpt = tmp_path / "c.ckpt"
     with pytest.raises(ValueError, match="training diverged at epoch 1"):
-        train(argdata.load(tiny), TrainSettings(hidden=8, epochs=2, batch=8), checkpoint=ckpt, progress=False)
+        train(argdata.load(tiny), TrainSettings(hidden=0, kernel=1, epochs=1, batch=24), checkpoint=ckpt, progress=False)
     assert not ckpt.exists()

@@ -23,8 +23,8 @@ def test_nominal_scenes_parse_exact_and_a_turned_camera_moves_the_centres():
 def test_the_perception_command_refuses_bad_options(capsys):
     from vcc.cli import main
 
-    for argv, message in [(["robot", "perception", "--out", "x.json", "--scenes", "0"], "--scenes 0: must be positive"),
-                          (["robot", "perception", "--out", "x.txt"], "--out x.txt: write a .json file")]:
+    for argv, message in [(["robot", "perception", "--out", "x.json", "--scenes", "0"], "argument --scenes: 0 is out of range"),
+                          (["robot", "perception", "--out", "x.txt"], "argument --out: x.txt: write .json")]:
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert message in err and err.count("\n") == 1

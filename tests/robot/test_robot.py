@@ -224,19 +224,19 @@ def test_robot_cli_errors_are_one_line(capsys):
     for argv, message in [
         (["robot", "run", "--concept", "no_such_concept"], "unknown concept 'no_such_concept'"),
         (["robot", "run", "--concept", "x", "--program", "scene_parse; jump"], "unknown instruction"),
-        (["robot", "run", "--concept", POINTED, "--frames", "f.gif"], "--frames f.gif: write .png or .jpg"),
-        (["robot", "run", "--concept", POINTED, "--video", "v.mov"], "--video v.mov: write .mp4 or .avi"),
-        (["robot", "run", "--concept", POINTED, "--scenarios", "0"], "--scenarios 0: must be positive"),
+        (["robot", "run", "--concept", POINTED, "--frames", "f.gif"], "argument --frames: f.gif: write .png or .jpg"),
+        (["robot", "run", "--concept", POINTED, "--video", "v.mov"], "argument --video: v.mov: write .mp4 or .avi"),
+        (["robot", "run", "--concept", POINTED, "--scenarios", "0"], "argument --scenarios: 0 is out of range"),
         (["robot", "suite", "--out", "x", "--concepts", "no_such_concept"], "no_such_concept: not induced in"),
         (["robot", "suite", "--out", "x", "--concepts", "change_all_objs_color"], "recolours"),
         (["robot", "suite", "--out", "x", "--shard", "2/2"], "--shard 2/2: K must be in 0..N-1"),
         (["robot", "suite", "--out", "x", "--shard", "half"], "--shard half: give K/N"),
         (["robot", "suite", "--out", "x", "--source", "no/such/run"], "results.jsonl: missing"),
-        (["robot", "suite", "--out", "x", "--scenarios", "0"], "--scenarios and --count must be positive"),
+        (["robot", "suite", "--out", "x", "--scenarios", "0"], "argument --scenarios: 0 is out of range"),
     ]:
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
-        assert err.startswith("vcc: error: ") and message in err and err.count("\n") == 1, err
+        assert err.startswith("vcc") and ": error: " in err and message in err and err.count("\n") == 1, err
 
 
 def test_run_reads_a_long_program_as_text_a_file_as_a_file_and_refuses_a_missing_file(tmp_path, capsys):

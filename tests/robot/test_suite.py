@@ -109,8 +109,8 @@ def test_programs_come_from_an_induce_run_when_asked(tmp_path):
         programs_of("move_bottom_to_pointed+move_to_middle", tmp_path)
     with pytest.raises(DataFileError, match="results.jsonl: missing"):
         programs_of("move_bottom_to_pointed", tmp_path / "none")
-    (tmp_path / "results.jsonl").write_text("{not json\n")
-    with pytest.raises(DataFileError, match="line 1 is not a result"):
+    (tmp_path / "results.jsonl").write_text("{not json\n" + json.dumps(lines[1]) + "\n")  # not a last line cut short
+    with pytest.raises(DataFileError, match="line 1 is not a JSON record"):
         programs_of("move_bottom_to_pointed", tmp_path)
 
 

@@ -242,7 +242,14 @@ def test_cli_induce_refuses_a_dataset_without_the_concept_or_other_examples(tmp_
            "--iterations", "1", "--quiet"]
     assert main(run) == 0
     capsys.readouterr()
-    entry["sha256"] = "0" * 64  # as if rebuilt differently: the manifest names other bytes
+    import hashlib
+
+    from vccjax.world.dataset import read_npz, write_npz
+
+    arrays = read_npz(part / entry["file"])  # rebuilt differently: one test scene moved a little
+    arrays["test_in"][0, 0, 3] = min(arrays["test_in"][0, 0, 3] + 0.001, 0.9)
+    write_npz(part / entry["file"], arrays)
+    entry["sha256"] = hashlib.sha256((part / entry["file"]).read_bytes()).hexdigest()
     (part / "manifest.json").write_text(json.dumps({**manifest, "concepts": {"remove_bottom_obj": entry}}))
     assert main([*run, "--dataset", str(part)]) == 2
     err = capsys.readouterr().err.strip()
@@ -270,13 +277,13 @@ def test_a_run_with_predicted_arguments_resumes_only_under_the_same_weights(tmp_
     settings = Settings(budget=1000, args="predicted")
     run = Run(tmp_path / "r", settings)
     run.check_predictor("a" * 64)
-    run.append({"concept": "c", "iteration": 0, "found": False})
+    run.append({"concept": "c", "iteration": 0, "found": False, "program": None})
     again = Run(tmp_path / "r", settings)
     again.check_predictor("a" * 64)  # the same weights: resumes
     with pytest.raises(DataFileError, match="other argument-predictor weights"):
         Run(tmp_path / "r", settings).check_predictor("b" * 64)
     (tmp_path / "r2").mkdir()
     old = Run(tmp_path / "r2", settings)  # records made before the weights were recorded
-    old.append({"concept": "c", "iteration": 0, "found": False})
+    old.append({"concept": "c", "iteration": 0, "found": False, "program": None})
     with pytest.raises(DataFileError, match="do not say which"):
         Run(tmp_path / "r2", settings).check_predictor("a" * 64)

@@ -189,7 +189,7 @@ def test_bad_examples_are_refused_in_one_line_and_nothing_is_written(data, tmp_p
     (["--save"], "--save needs --name"),
     (["--name", "Bad Name", "--save"], "--name 'Bad Name'"),
     (["--name", CONCEPT, "--save"], "a shipped concept has this name"),
-    (["--budget", "0"], "--budget must be positive"),
+    (["--budget", "0"], "argument --budget: 0 is out of range"),
     (["--library", "no/such/library.json"], "no/such/library.json: missing"),
     (["--budget", "3"], "no program under the budget"),
 ])

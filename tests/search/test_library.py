@@ -71,7 +71,7 @@ def test_a_library_of_another_version_or_predictor_is_refused(run_folder, tmp_pa
         with pytest.raises(DataFileError, match=message):
             library.load(path)
     path.write_text("{not json")
-    with pytest.raises(DataFileError, match="not a readable JSON file"):
+    with pytest.raises(DataFileError, match="lib.json: not JSON"):
         library.load(path)
 
 

@@ -155,7 +155,7 @@ def run_case(case: dict, tmp: Path) -> dict:
 
 # The default suite runs one quick case in DEFAULT_EVERY (a spread over every command,
 # about 1.5 s each); `-m slow` runs all the others, so the two together are the table.
-DEFAULT_EVERY = 5
+DEFAULT_EVERY = 10
 
 
 def _param(case: dict, index: int):
