@@ -122,38 +122,45 @@ def test_resume_keeps_good_files_and_rebuilds_bad_ones(small, tmp_path):
         assert f.read_bytes() == (small / f.name).read_bytes()
 
 
-def test_building_some_concepts_into_a_dataset_adds_to_it_and_drops_none(small, tmp_path):
-    """`vcc dataset build --concepts X --out FULL` once cut FULL's manifest to X alone."""
+def _shipped_part(folder, names=("remove_bottom_obj", "move_to_middle")):
+    """Two concepts of the shipped dataset (seed 0) copied into `folder`, with their manifest."""
     import shutil
 
-    for f in small.iterdir():
-        shutil.copy(f, tmp_path / f.name)
-    before = json.loads((tmp_path / "manifest.json").read_text())
-    build_dataset(tmp_path, SOME[:1], seed=3, progress=False)  # its file is intact: kept, not redrawn
+    manifest = json.loads((shipped_folder() / "manifest.json").read_text())
+    manifest["concepts"] = {n: manifest["concepts"][n] for n in names}
+    manifest["rivals_left"] = {n: v for n, v in manifest["rivals_left"].items() if n in names}
+    for entry in manifest["concepts"].values():
+        shutil.copy(shipped_folder() / entry["file"], folder / entry["file"])
+    (folder / "manifest.json").write_text(json.dumps(manifest))
+    return manifest
+
+
+def test_building_some_concepts_into_a_dataset_adds_to_it_and_drops_none(tmp_path):
+    """`vcc dataset build --concepts X --out FULL` once cut FULL's manifest to X alone."""
+    before = _shipped_part(tmp_path)
+    build_dataset(tmp_path, ["move_to_middle"], seed=0, progress=False)  # its file is intact: kept, not redrawn
     after = json.loads((tmp_path / "manifest.json").read_text())
-    assert after["concepts"] == before["concepts"] and sorted(Dataset(tmp_path).concepts) == sorted(SOME)
+    assert after["concepts"] == before["concepts"]
+    assert sorted(Dataset(tmp_path).concepts) == ["move_to_middle", "remove_bottom_obj"]
     with pytest.raises(DataFileError, match="another seed"):
-        build_dataset(tmp_path, SOME[:1], seed=4, progress=False)  # never two seeds in one folder
+        build_dataset(tmp_path, ["move_to_middle"], seed=4, progress=False)  # never two seeds in one folder
     assert json.loads((tmp_path / "manifest.json").read_text()) == after
 
 
-def test_a_concept_file_of_the_right_hash_but_no_scenes_is_refused(small, tmp_path):
+def test_a_concept_file_of_the_right_hash_but_no_scenes_is_refused(tmp_path):
     """A file a foreign program made (its hashes right, its scenes nonsense) is refused
     by name and reason, not read into wrong scenes."""
     import hashlib
-    import shutil
 
-    for f in small.iterdir():
-        shutil.copy(f, tmp_path / f.name)
-    manifest = json.loads((tmp_path / "manifest.json").read_text())
-    entry = manifest["concepts"][SOME[0]]
+    manifest = _shipped_part(tmp_path)
+    entry = manifest["concepts"]["move_to_middle"]
     arrays = read_npz(tmp_path / entry["file"])
     arrays["train_in"][0, 0, 1] = 99  # a shape index no shape has
     write_npz(tmp_path / entry["file"], arrays)
     entry["sha256"] = hashlib.sha256((tmp_path / entry["file"]).read_bytes()).hexdigest()
     (tmp_path / "manifest.json").write_text(json.dumps(manifest))
     with pytest.raises(DataFileError, match="train_in has a shape index outside"):
-        Dataset(tmp_path).pairs(SOME[0])
+        Dataset(tmp_path).pairs("move_to_middle")
 
 
 def test_corrupt_and_foreign_files_are_refused(small, tmp_path):
