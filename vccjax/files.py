@@ -116,7 +116,8 @@ def hold(folder: str | Path, what: str = "run folder", name: str = LOCK_NAME) ->
         raise VCCError(f"{folder}: this {what} is in use by {holder}; wait for it to end "
                        "or stop it, then rerun") from None
     os.ftruncate(fd, 0)
-    command = " ".join(Path(a).name if i == 0 else a for i, a in enumerate(sys.argv))
+    program = Path(sys.argv[0]).name if sys.argv and sys.argv[0] else "python"
+    command = " ".join(["vcc" if program == "__main__.py" else program, *sys.argv[1:]])
     os.write(fd, f"pid {os.getpid()} on {socket.gethostname()} ({command})\n".encode())
     _held[lock] = fd
     if folder.is_dir():
