@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import math
 import shlex
 import subprocess
 from pathlib import Path
@@ -12,16 +11,6 @@ from pathlib import Path
 from vccjax import runtime
 
 DEFAULT_DATA = Path.home() / ".cache" / "vccjax" / "argpred-data"
-
-
-def _require(ok: bool, option: str, want: str, value) -> None:
-    """Refuse a bad option before anything is drawn, trained or written."""
-    if not ok:
-        raise ValueError(f"{option} must be {want}, got {value!r}")
-
-
-def _share(option: str, value: float) -> None:
-    _require(math.isfinite(value) and 0 <= value <= 1, option, "a share from 0 to 1", value)
 
 
 def _write_json(path: Path, data: dict) -> None:
@@ -60,9 +49,6 @@ def cmd_data(a: argparse.Namespace) -> int:
 
     from argpred.data import build, built
 
-    _require(a.programs >= 1, "--programs", "at least 1", a.programs)
-    _share("--joined", a.joined)
-    _require(a.workers >= 0, "--workers", "0 (one per core) or more", a.workers)
     joined = 0.0 if a.kind == "carry" else a.joined
     m = build(a.out, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet,
               joined=joined, kind=a.kind)
@@ -81,19 +67,6 @@ def cmd_train(a: argparse.Namespace) -> int:
     from argpred.train import TrainSettings, train_members
     from argpred.weights import record, save
 
-    for option, value in (("--epochs", a.epochs), ("--batch", a.batch), ("--kernel", a.kernel), ("--depth", a.depth),
-                          ("--members", a.members)):
-        _require(value >= 1, option, "at least 1", value)
-    for option, value in (("--hidden", a.hidden), ("--carry", a.carry), ("--workers", a.workers)):
-        _require(value >= 0, option, "0 or more", value)
-    if a.programs is not None:
-        _require(a.programs >= 1, "--programs", "at least 1", a.programs)
-    if a.joined is not None:
-        _share("--joined", a.joined)
-    for option, value in (("--lr", a.lr), ("--positive-weight", a.positive_weight)):
-        _require(math.isfinite(value) and value > 0, option, "a positive number", value)
-    _require(math.isfinite(a.l1) and a.l1 >= 0, "--l1", "0 or a positive number", a.l1)
-    _require(math.isfinite(a.bias_start), "--bias-start", "a finite number", a.bias_start)
     out = Path(a.out)
     if out.is_dir():
         raise ValueError(f"--out {out}: a folder; give the weights file to write")
@@ -149,7 +122,6 @@ def cmd_recall(a: argparse.Namespace) -> int:
     from vccjax.world.concepts import concept_list
 
     names = concept_list(a.concepts)
-    _require(a.show >= 0, "--show", "0 or more", a.show)
     if a.record and (a.concepts != "all" or a.dataset):
         raise ValueError("--record keeps the recall on all the concepts' shipped examples in the weights card: "
                          "leave out --concepts and --dataset")
