@@ -8,7 +8,8 @@ resumes and refuses a folder made with other settings, programs or examples):
 - `ask`: each concept from 2 examples with the library, as `vcc learn` runs: whether
   the first program found is right, whether the pairs were reported ambiguous, and,
   when they were, whether one answered query settles it (the query's input with the
-  output the concept's own program gives there, added as a third pair).
+  output the concept's own program gives there, added as a third pair, and learned again
+  with the programs the question was about, as `vcc learn` reruns in the same folder).
 The concept's program is read only to make its examples and to answer the query, as a
 user would; never by the search.
 """
@@ -27,6 +28,9 @@ from vccjax import runtime
 from vccjax.records import append_line
 
 STARTS = ("library", "uniform")
+# 2: the answered question is learned again with the programs it was about, and fresh
+# scenes may hold one object more than the examples (a run of another protocol is refused)
+PROTOCOL = 2
 # What every results line must hold (the key of `_key`, and whether it was found).
 RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 
@@ -71,7 +75,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
     runtime.prepare()
     run = Path(a.run)
     asking = LearnSettings(budget=a.budget)
-    head = {"budget": a.budget, "examples": examples, "ask_examples": a.ask_examples,
+    head = {"protocol": PROTOCOL, "budget": a.budget, "examples": examples, "ask_examples": a.ask_examples,
             "ask_settings": dataclasses.asdict(asking),
             "programs_sha256": hashlib.sha256(Path(a.programs).read_bytes()).hexdigest()}
     if (run / "run.json").exists():  # a run of other settings is refused before examples are built into it
@@ -142,9 +146,11 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
             if m.failed:
                 rec["settled"], rec["answer"] = False, "the concept's program fails on the query"
             else:
-                again = learn([*pairs, (q, m.output_scene())], settings, explorer)
+                asked = [first.program] + [p for p, *_ in first.rivals()]  # as a `vcc learn` rerun reads them
+                again = learn([*pairs, (q, m.output_scene())], settings, explorer, asked=asked)
                 rec["settled"] = bool(again.found and generalization(again.program, test, tau) == len(test))
                 rec["settled_program"] = again.program.text() if again.found else None
+                rec["from_question"] = bool(again.found and again.program in asked)
                 rec["still_ambiguous"] = again.ambiguous
         write(rec)
         if not a.quiet:
@@ -225,7 +231,7 @@ def _write_summary(a: argparse.Namespace, summary: dict, timing: dict | None, ru
     if timing:
         print(f"vcc learn {timing['concept']} ({timing['instructions']} instructions, 5 pairs): "
               f"cold {timing['cold_seconds']} s, warm {timing['warm_seconds']} s on {timing['cores']} cores")
-    print(f"-> {out}")
+    print(f"-> {a.out}")
 
 
 def add_command(bsub) -> None:

@@ -18,6 +18,7 @@ import numpy as np
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.errors import SceneError
 from vccjax.machine.scene import Scene, SceneObject, to_units
+from vccjax.vision.grey_fit import GREY_FIT_MAX_PX, grey_fit
 from vccjax.vision.shape_fit import fit_shapes
 
 # OpenCV hue (0..180) bands of the four colours; anything saturated outside them is unknown.
@@ -33,6 +34,7 @@ class ParseOptions:
     edge_saturation: int = 40  # a region grows into connected pixels of its hue down to this (blurred edges)
     outline_value: int = 90  # darker pixels hugging a region are its outline, part of the object
     outline_width: float = 0.008  # of the image's side: how far an outline may reach out
+    grey_fit: bool = True  # judge small objects' shapes on grey levels too (`vccjax.vision.grey_fit`)
 
 
 def _hue_mask(hsv: np.ndarray, bands) -> np.ndarray:
@@ -93,7 +95,11 @@ def parse_image(image: np.ndarray, options: ParseOptions = ParseOptions()) -> Sc
             shaped = _luma_points(region & (half | dark), labels == k, luma, ~mine | (saturated & ~hue), reach)
             ys, xs = np.nonzero(shaped)
             x0, y0, x1, y1 = xs.min(), ys.min(), xs.max() + 1, ys.max() + 1
-            for shape, cx, cy, width in fit_shapes(shaped[y0:y1, x0:x1], x0, y0):
+            fits = fit_shapes(shaped[y0:y1, x0:x1], x0, y0)
+            if options.grey_fit and len(fits) == 1 and max(x1 - x0, y1 - y0) <= GREY_FIT_MAX_PX:
+                fits = [_grey_refit(fits[0], luma, labels == k, mine & ~(saturated & ~hue) & ~under_pointer,
+                                    (x0, y0, x1, y1), reach)]
+            for shape, cx, cy, width in fits:
                 objects.append(SceneObject(shape, color, cx / size_x, cy / size_y, width / size_x))
     leftover = saturated & ~claimed
     leftover = cv2.morphologyEx(leftover.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
@@ -203,6 +209,29 @@ def _luma_points(shaped: np.ndarray, core: np.ndarray, luma: np.ndarray, others:
         return shaped
     out[y0:y1, x0:x1] = _follow(start, ink, _point_reach(shaped))
     return out
+
+
+def _grey_refit(fit: tuple, luma: np.ndarray, core: np.ndarray, usable: np.ndarray,
+                box: tuple[int, int, int, int], reach: int) -> tuple:
+    """A small object's shape, centre and width from its grey levels (`grey_fit`), in
+    place of the region's fit; the region's fit stands where brightness says too little."""
+    x0, y0, x1, y1 = box
+    pad = max(x1 - x0, y1 - y0) + 4 * reach + 4
+    ya, xa = max(y0 - pad, 0), max(x0 - pad, 0)
+    yb, xb = min(y1 + pad, luma.shape[0]), min(x1 + pad, luma.shape[1])
+    window = np.zeros(luma.shape, bool)
+    window[ya:yb, xa:xb] = True
+    around = window.copy()
+    around[max(y0 - 2 * reach - 2, 0):y1 + 2 * reach + 2, max(x0 - 2 * reach - 2, 0):x1 + 2 * reach + 2] = False
+    table = luma[around & usable]
+    if table.size < 16:
+        return fit
+    bg, body = float(np.median(table)), float(np.median(luma[core]))
+    if bg - body < 24:
+        return fit
+    darkness = np.clip((bg - luma.astype(np.float32)) / (bg - body), -0.5, 3.0)
+    shape, cx, cy, width, _, _ = grey_fit(darkness, usable, box)
+    return shape, cx, cy, width
 
 
 def _point_reach(region: np.ndarray) -> int:
