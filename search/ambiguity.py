@@ -1,8 +1,8 @@
 """Whether a few examples leave a concept ambiguous, and which scene would settle it.
 
 Several programs may explain every given pair. They are run on fresh scenes drawn like
-the user's inputs (the same shapes and colours, as many objects, as wide, a pointer
-when the inputs have one); programs that give the same outcome on every fresh scene
+the user's inputs (the same shapes and colours, as many objects or one more, as wide, a
+pointer when the inputs have one); programs that give the same outcome on every fresh scene
 behave alike and count as one. The examples are ambiguous when a program that behaves
 unlike the first one found gives another output on a fresh scene where the first runs
 (on at least `min_scenes` of them, so a rare tie of distances is not an alarm). The
@@ -26,11 +26,14 @@ from vccjax.machine.scene import Scene, scenes_match
 
 
 TEMPER_NATS = 3.0  # description lengths are overconfident (docs/learn.md, "Ambiguity")
+# Fresh scenes hold as many objects as the inputs, or one more (up to this many): what a
+# concept does with one object more is what a few small examples most often leave open.
+MORE_OBJECTS_UP_TO = 8
 
 
 @dataclasses.dataclass(frozen=True)
 class SceneStyle:
-    """What fresh scenes share with the user's inputs."""
+    """What fresh scenes share with the user's inputs (as many objects or one more)."""
 
     objects: tuple[int, int]
     widths: tuple[float, float]
@@ -44,7 +47,8 @@ class SceneStyle:
         counts = [len(s.objects) for s in inputs]
         widths = [o.width for s in inputs for o in s.objects]
         pointed = [s for s in inputs if s.pointer is not None]
-        return cls((min(counts), max(counts)), (min(widths), max(widths)),
+        most = max(max(counts), min(max(counts) + 1, MORE_OBJECTS_UP_TO))
+        return cls((min(counts), most), (min(widths), max(widths)),
                    tuple(sorted({o.shape for s in inputs for o in s.objects})),
                    tuple(sorted({o.color for s in inputs for o in s.objects})),
                    bool(pointed), bool(pointed) and all(_points_at_an_object(s, cfg) for s in pointed))

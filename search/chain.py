@@ -186,6 +186,31 @@ class Chain:
             last = int(self.tok[z])
         return total + int(self.trans_bins[last, self.end])
 
+    def cheapest(self, ops: tuple[int, ...], args: tuple[int, ...]) -> tuple[float, list[int]] | None:
+        """(description length in nats, portions) of an atomic program's cheapest spelling in
+        this chain's tokens (subroutine calls where their bodies match), or None where the
+        chain cannot spell it (an argument it rules out, or broken syntax)."""
+        if not hasattr(self, "_portion_of"):
+            self._portion_of = {(int(t), tuple(a)): z for z, (t, a) in reversed(list(enumerate(zip(self.tok, self.args))))}
+        n, inf = len(ops), math.inf
+        best: list[dict[tuple[int, int], tuple[float, list[int]]]] = [dict() for _ in range(n + 1)]
+        best[0][(self.end, NOT_STARTED)] = (0.0, [])
+        for i in range(n):
+            for (last, syn), (nats, path) in best[i].items():
+                for t in range(self.vocab.size):
+                    atoms = self.vocab.atoms(t)
+                    z = self._portion_of.get((t, tuple(args[i:i + len(atoms)])))
+                    nxt = self.next_syn[t, syn]
+                    if z is None or nxt < 0 or tuple(ops[i:i + len(atoms)]) != atoms:
+                        continue
+                    cost = nats + float(self.trans_nats[last, t] + self.argnats[z])
+                    key = (t, int(nxt))
+                    if cost < best[i + len(atoms)].get(key, (inf,))[0]:
+                        best[i + len(atoms)][key] = (cost, path + [z])
+        ends = [(nats + float(self.trans_nats[last, self.end]), path)
+                for (last, syn), (nats, path) in best[n].items() if syn == OUTSIDE]
+        return min(ends, key=lambda e: e[0]) if ends else None
+
     def program_nats(self, portions: list[int]) -> float:
         last, total = self.end, 0.0
         for z in portions:

@@ -144,7 +144,8 @@ def with_rivals(first: Result, chain: Chain, task: Task, settings: LearnSettings
     The depth-first search prunes by its cutoff as it goes, so a cutoff raised after the
     first fit would miss programs in branches already cut: the pass starts over with the
     higher cutoff. The first program stays the answer (the pass finds it again, or one of
-    the same cost, which then counts as a rival). With the examples' `inputs`, rivals are
+    the same cost, which then counts as a rival), unless it came from an earlier question
+    (`settle`) and the pass finds a cheaper fit. With the examples' `inputs`, rivals are
     kept one per behaviour (`alternatives_for`)."""
     if not first.found or settings.rival_budget == 0:
         return first
@@ -153,6 +154,10 @@ def with_rivals(first: Result, chain: Chain, task: Task, settings: LearnSettings
     again = searcher.search(chain, task, budget, progress, alternatives)
     others = [Alternative(again.program, again.text, again.dl_nats)] if again.found else []
     others += list(again.alternatives)
+    if again.found and again.dl_bins < first.dl_bins:  # `first` came from a question (`settle`), past the budget
+        others[0] = Alternative(first.program, first.text, first.dl_nats)
+        first = dataclasses.replace(first, program=again.program, text=again.text, dl_nats=again.dl_nats,
+                                    dl_bins=again.dl_bins, rank=again.rank)
     kept = tuple(a for a in others if a.program != first.program)[: settings.max_rivals - 1]
     return dataclasses.replace(first, alternatives=kept, programs=first.programs + again.programs,
                                nodes=first.nodes + again.nodes, seconds=first.seconds + again.seconds,
@@ -169,9 +174,38 @@ def verdict_for(result: Result, pairs: Sequence[tuple[Scene, Scene]], settings: 
                  DEFAULT_CONFIG, nats)
 
 
+def settle(searched: Result, chain: Chain, pairs: Sequence[tuple[Scene, Scene]],
+           asked: Sequence[Program]) -> Result:
+    """The search's result, or the cheapest of the `asked` programs (those a question was
+    about) that explains every pair where it is cheaper or the search found nothing.
+
+    A question is asked about programs the rival pass found, up to `rival_budget` past the
+    budget; the answer picks among them, so one it keeps must not be lost because a fresh
+    search from the pairs stops at the budget's cutoff."""
+    from search.induce import generalization
+    from search.result import text_of
+
+    best = None
+    for program in asked:
+        spelt = chain.cheapest(program.ops, program.args)
+        if spelt is None or (best is not None and spelt[0] >= best[0]):
+            continue
+        if generalization(program, pairs, DEFAULT_CONFIG.tau) == len(pairs):
+            best = spelt
+    if best is None or (searched.found and searched.dl_nats <= best[0]):
+        return searched
+    nats, portions = best
+    bins = chain.program_bins(portions)
+    counts = chain.count_table(budget=2**62, max_bins=bins)
+    rank = int(counts[bins - 1]) + 1 if bins > 0 else 1
+    return dataclasses.replace(searched, found=True, program=program_of(chain, portions),
+                               text=text_of(chain, portions), dl_nats=nats, dl_bins=bins, rank=rank)
+
+
 def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searcher: Searcher | None = None,
-          progress: Callable[[int], None] | None = None) -> Learned:
-    """Learn a program for `pairs` (at least one), and judge the rivals found beside it."""
+          progress: Callable[[int], None] | None = None, asked: Sequence[Program] = ()) -> Learned:
+    """Learn a program for `pairs` (at least one), and judge the rivals found beside it.
+    `asked`: the programs an earlier question was about, when `pairs` holds its answer."""
     if not pairs:
         raise ValueError("learning needs at least one example pair")
     chain, name = chain_for(pairs, settings)
@@ -180,7 +214,7 @@ def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searche
 
         searcher = Explorer(width=1)
     task = Task.from_pairs(pairs)
-    result = with_rivals(searcher.search(chain, task, settings.budget, progress), chain, task, settings, searcher,
-                         progress, [a for a, _ in pairs])
+    first = settle(searcher.search(chain, task, settings.budget, progress), chain, pairs, asked)
+    result = with_rivals(first, chain, task, settings, searcher, progress, [a for a, _ in pairs])
     verdict, scenes = verdict_for(result, pairs, settings)
     return Learned(result, name, verdict, scenes)

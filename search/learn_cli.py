@@ -15,7 +15,8 @@ import tempfile
 from pathlib import Path
 
 from vccjax import files as vfiles, runtime
-from vccjax.errors import VCCError
+from vccjax.errors import DataFileError, ProgramSyntaxError, VCCError, read_json
+from vccjax.records import check_fields
 
 QUERY_FILES = ("query.json", "query.png", "query_in.json")
 
@@ -58,6 +59,27 @@ def concept_record(learned, examples: list[tuple[str, object, object]], files: l
     }
 
 
+def asked_before(out: Path, files: list[str]) -> list:
+    """The programs the question in `out` was about (the program learned and its rivals),
+    when the examples now hold every pair that question was learned from and more: the
+    user answered it. A fresh search stops at the budget's cutoff, and the answer must
+    not lose a rival the question was asked about (`search.learn.settle`)."""
+    from vccjax.machine.program import parse
+
+    path = out / "concept.json"
+    if not path.is_file():
+        return []
+    old = read_json(path, DataFileError, "missing")
+    try:
+        check_fields(old, {"program": (str,), "rivals": (list,), "examples": (list,), "ambiguous": (bool,)}, str(path))
+        if not old["ambiguous"] or not set(old["examples"]) < set(files):
+            return []
+        return [parse(old["program"])] + [parse(check_fields(r, {"program": (str,)}, f"{path}: rival")["program"])
+                                          for r in old["rivals"]]
+    except ProgramSyntaxError as e:
+        raise DataFileError(f"{path}: not a concept.json of vcc learn ({e})") from None
+
+
 def _write_json(folder: Path, name: str, content) -> None:
     vfiles.write_json(folder / name, content)
 
@@ -91,7 +113,10 @@ def cmd_learn(a: argparse.Namespace) -> int:
         from search.scalar import ScalarExplorer
 
         searcher = ScalarExplorer(width=1)
-    learned = learn(pairs, settings, searcher, progress=lambda n: bar.update(n))
+    asked = asked_before(Path(a.out), files)
+    if asked:
+        print(f"the pairs answer the question in {a.out}: its {len(asked)} programs are weighed too")
+    learned = learn(pairs, settings, searcher, progress=lambda n: bar.update(n), asked=asked)
     bar.close()
     r = learned.result
     if not r.found:

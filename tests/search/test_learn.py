@@ -199,3 +199,52 @@ def test_bad_options_and_nothing_found_exit_non_zero(data, tmp_path, capsys, fla
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1, err
     assert not out.exists()
+
+
+def test_an_answered_question_keeps_a_rival_the_budget_alone_would_not_reach(data):
+    """`settle`: the programs a question was about are weighed with the search's; one that
+    explains every pair is kept even when the budget's cutoff lies below it, and one that
+    does not explain them is never taken."""
+    truth = reference_program(CONCEPT)
+    pairs = data.pairs(CONCEPT, "train")[:3]
+    tiny = LearnSettings(budget=1, rival_budget=0)
+    assert not learn(pairs, tiny, ScalarExplorer(width=1)).found
+    wrong = parse("scene_parse; fixate(right); top_down_attend; remove_from_imagine_buffer")
+    assert not _explains(wrong, pairs)
+    got = learn(pairs, tiny, ScalarExplorer(width=1), asked=[wrong, truth])
+    assert got.found and got.program == truth and got.result.rank > 1
+    assert not learn(pairs, tiny, ScalarExplorer(width=1), asked=[wrong]).found
+
+
+def test_a_programs_cheapest_spelling_is_what_the_search_paid_or_less(data):
+    from search.learn import chain_for
+
+    pairs = data.pairs(CONCEPT, "train")[:3]
+    settings = LearnSettings(budget=20_000, rival_budget=0)
+    found = learn(pairs, settings, ScalarExplorer(width=1)).result
+    chain, _ = chain_for(pairs, settings)
+    nats, portions = chain.cheapest(found.program.ops, found.program.args)
+    assert nats <= found.dl_nats + 1e-9 and abs(chain.program_nats(portions) - nats) < 1e-9
+    assert chain.cheapest(found.program.ops[1:], found.program.args[1:]) is None  # no scene_parse first
+
+
+def test_a_rerun_with_the_answer_weighs_the_programs_asked_about(data, tmp_path, capsys):
+    """The user answers the question and reruns in the same folder with a budget too small
+    to find anything: the answer still settles it among the programs asked about."""
+    two = data.pairs(CONCEPT, "train")[:2]
+    folder, out = _folder(tmp_path / "ex", two), tmp_path / "out"
+    assert main(["learn", str(folder), "--out", str(out), *QUICK]) == 0
+    (folder / "q_in.json").write_text((out / "query_in.json").read_text())
+    scene = Scene.load(out / "query_in.json")
+    RefMachine(scene).run(reference_program(CONCEPT)).output_scene().save(folder / "q_out.json")
+    capsys.readouterr()
+    assert main(["learn", str(folder), "--out", str(out), "--engine", "reference", "--budget", "1", "--quiet"]) == 0
+    assert "the pairs answer the question" in capsys.readouterr().out
+    learned = json.loads((out / "concept.json").read_text())
+    assert _explains(parse(learned["program"]), data.pairs(CONCEPT, "test"))
+    # a concept.json that is not one of vcc learn's is refused, naming it
+    (out / "concept.json").write_text(json.dumps({"program": "no_such_op", "rivals": [], "examples": [],
+                                                  "ambiguous": True}))
+    assert main(["learn", str(folder), "--out", str(out), *QUICK]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "concept.json" in err[0]
