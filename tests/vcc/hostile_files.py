@@ -295,3 +295,14 @@ def setup_examples(tmp: Path) -> None:
     _write(e / "dir_pair" / "1_out.json", json.dumps(blue))
     _pair(e / "eleven", "1", {"objects": [{"shape": "circle", "color": "red", "x": 0.05 + 0.09 * i, "y": 0.5,
                                            "width": 0.05} for i in range(11)]}, blue)
+    # --out folders of an earlier `vcc learn` whose concept.json (read back by a rerun
+    # for the programs its question was about) is not one vcc learn wrote
+    a = tmp / "asked"
+    _write(a / "garbage" / "concept.json", bytes(random.Random(5).randrange(256) for _ in range(200)))
+    _json(a / "list" / "concept.json", [])
+    _json(a / "bad_program" / "concept.json", {"program": "no_such_op", "rivals": [], "examples": [],
+                                               "ambiguous": True})
+    _json(a / "rival_types" / "concept.json", {"program": "scene_parse", "rivals": [{"program": 3}],
+                                               "examples": [], "ambiguous": True})
+    _json(a / "field_types" / "concept.json", {"program": "scene_parse", "rivals": "none", "examples": [],
+                                               "ambiguous": "yes"})
