@@ -72,6 +72,8 @@ def asked_before(out: Path, files: list[str]) -> list:
     old = read_json(path, DataFileError, "missing")
     try:
         check_fields(old, {"program": (str,), "rivals": (list,), "examples": (list,), "ambiguous": (bool,)}, str(path))
+        if not all(isinstance(e, str) for e in old["examples"]):
+            raise DataFileError(f"{path}: field 'examples' must list the pair files as strings")
         if not old["ambiguous"] or not set(old["examples"]) < set(files):
             return []
         return [parse(old["program"])] + [parse(check_fields(r, {"program": (str,)}, f"{path}: rival")["program"])

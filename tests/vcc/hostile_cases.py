@@ -319,7 +319,7 @@ case("learn-out-empty", "learn", EXOK, *_flags(LE, out=""), setup="examples",
      writes=["{tmp}/concept.json", "{tmp}/trace.png"])
 case("learn-out-parent-file", "learn", EXOK, *_flags(LE, out="{file}/out"), setup="examples", writes=["{file}"])
 case("learn-out-missing", "learn", EXOK, *_flags(LE, out=None), setup="examples")
-for name in ("garbage", "list", "bad_program", "rival_types", "field_types"):  # a rerun reads the old question
+for name in ("garbage", "list", "bad_program", "rival_types", "example_types", "field_types"):  # a rerun reads the old question
     case(f"learn-asked-{name.replace('_', '-')}", "learn", EXOK, *_flags(LE, out=f"{{tmp}}/asked/{name}"),
          setup="examples", writes=[f"{{tmp}}/asked/{name}/concept.json"])
 case("learn-budget-zero", "learn", EXOK, *_flags(LE, budget="0"), setup="examples", writes=W_OUT)

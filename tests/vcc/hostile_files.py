@@ -304,5 +304,7 @@ def setup_examples(tmp: Path) -> None:
                                                "ambiguous": True})
     _json(a / "rival_types" / "concept.json", {"program": "scene_parse", "rivals": [{"program": 3}],
                                                "examples": [], "ambiguous": True})
+    _json(a / "example_types" / "concept.json", {"program": "scene_parse", "rivals": [], "examples": [{"a": 1}],
+                                                 "ambiguous": True})
     _json(a / "field_types" / "concept.json", {"program": "scene_parse", "rivals": "none", "examples": [],
                                                "ambiguous": "yes"})
