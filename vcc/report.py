@@ -224,6 +224,30 @@ def camera_section(results: list[tuple[str, dict]]) -> list[str]:
     return lines + [""]
 
 
+def learn_section(results: list[tuple[str, dict]]) -> list[str]:
+    """New concepts learned from their pairs (`vcc bench learn`): the library against from
+    scratch, the questions asked back, and `vcc learn`'s wall time cold and warm."""
+    runs = _latest(results, "learn")
+    if not runs:
+        return []
+    name, d = runs[-1]
+    lines = [f"## New concepts learned from their pairs ({d['concepts']}, none among the 546)", "", _stamp(name, d), "",
+             "| start, examples | found | right on all test pairs |", "|---|---|---|"]
+    for label, row in d["learn"].items():
+        lines.append(f"| {label} | {row['found']} of {row['concepts']} | {row['right']} of {row['concepts']} |")
+    a = d["ask"]
+    lines += ["", f"Asking back from {a['examples']} examples: first program right {a['first_right']}, wrong "
+              f"{a['first_wrong']}; of the wrong, reported ambiguous {a['wrong_reported_ambiguous']}, settled by one "
+              f"answered query {a['wrong_settled_by_one_query']}; right but reported ambiguous "
+              f"{a['right_reported_ambiguous']}."]
+    t = d.get("timing")
+    if t:
+        lines += ["", f"`vcc learn` on `{t['concept']}` ({t['instructions']} instructions, {t['pairs']} JSON pairs), "
+                      f"a fresh process each: cold {t['cold_seconds']} s, warm {t['warm_seconds']} s on "
+                      f"{t['cores']} cores."]
+    return lines + [""]
+
+
 def collect_rows(runs: Path) -> dict[str, dict]:
     """Every row folder under `runs` that holds a run, by folder name."""
     out = {}
@@ -256,7 +280,8 @@ def render(results_dir: Path, rows: dict[str, dict], stamp: dict, others: Path |
                             (lambda: reproduce_section(rows), runs),
                             (lambda: other_runs_section(others) if others else [], others),
                             (lambda: robot_section(robot) if robot else [], robot),
-                            (lambda: camera_section(results), results_dir)):
+                            (lambda: camera_section(results), results_dir),
+                            (lambda: learn_section(results), results_dir)):
         try:
             lines += section()
         except DataFileError:
