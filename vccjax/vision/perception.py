@@ -216,22 +216,21 @@ def _grey_refit(fit: tuple, luma: np.ndarray, core: np.ndarray, usable: np.ndarr
     """A small object's shape, centre and width from its grey levels (`grey_fit`), in
     place of the region's fit; the region's fit stands where brightness says too little."""
     x0, y0, x1, y1 = box
-    pad = max(x1 - x0, y1 - y0) + 4 * reach + 4
+    pad = max(x1 - x0, y1 - y0) + 4 * reach + 4  # wider than `grey_fit`'s own window
     ya, xa = max(y0 - pad, 0), max(x0 - pad, 0)
     yb, xb = min(y1 + pad, luma.shape[0]), min(x1 + pad, luma.shape[1])
-    window = np.zeros(luma.shape, bool)
-    window[ya:yb, xa:xb] = True
-    around = window.copy()
-    around[max(y0 - 2 * reach - 2, 0):y1 + 2 * reach + 2, max(x0 - 2 * reach - 2, 0):x1 + 2 * reach + 2] = False
-    table = luma[around & usable]
-    if table.size < 16:
+    grey, free = luma[ya:yb, xa:xb].astype(np.float32), usable[ya:yb, xa:xb]
+    around = free.copy()  # the table: the window less the object's box and its outline's reach
+    r = 2 * reach + 2
+    around[max(y0 - ya - r, 0):y1 - ya + r, max(x0 - xa - r, 0):x1 - xa + r] = False
+    if around.sum() < 16:
         return fit
-    bg, body = float(np.median(table)), float(np.median(luma[core]))
+    bg, body = float(np.median(grey[around])), float(np.median(luma[core]))
     if bg - body < 24:
         return fit
-    darkness = np.clip((bg - luma.astype(np.float32)) / (bg - body), -0.5, 3.0)
-    shape, cx, cy, width, _, _ = grey_fit(darkness, usable, box)
-    return shape, cx, cy, width
+    darkness = np.clip((bg - grey) / (bg - body), -0.5, 3.0)
+    shape, cx, cy, width, _, _ = grey_fit(darkness, free, (x0 - xa, y0 - ya, x1 - xa, y1 - ya))
+    return shape, cx + xa, cy + ya, width
 
 
 def _point_reach(region: np.ndarray) -> int:
