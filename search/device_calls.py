@@ -20,6 +20,7 @@ from jax.sharding import Mesh, NamedSharding
 from jax.sharding import PartitionSpec as P
 
 CALL_ROWS = 8  # a device call's fixed cost, in rows stepped
+BUCKETS = (16, 64, 256, 1024, 4096)  # the search's padded batch sizes
 
 RowsOf = Callable[..., object]  # `rows_of(a)` / `rows_of(a, via)`: a host array's rows for one piece
 Pending = list[tuple[np.ndarray, object]]  # (rows of each piece, its device outputs with the padding)
@@ -32,6 +33,15 @@ def _cheapest_cover(n: int, buckets: tuple[int, ...]) -> tuple[int, ...]:
     for m in range(1, n + 1):
         best[m] = min((CALL_ROWS + b + best[max(m - b, 0)][0], (b,) + best[max(m - b, 0)][1]) for b in buckets)
     return best[n][1]
+
+
+def piece_sizes(n: int, buckets: Sequence[int]) -> list[int]:
+    """Bucket sizes covering n rows at the least cost, counting each call as CALL_ROWS
+    rows of fixed overhead plus its padded rows (one 1024 call for 300 rows wastes more
+    than a 256 and a 64 cost)."""
+    buckets = tuple(sorted(buckets))
+    full, rest = divmod(n, buckets[-1])
+    return [buckets[-1]] * full + (list(_cheapest_cover(rest, buckets)) if rest else [])
 
 
 class DeviceCalls:
@@ -88,9 +98,5 @@ class DeviceCalls:
         return rows_of
 
     def piece_sizes(self, n: int) -> list[int]:
-        """Bucket sizes covering n rows at the least cost, counting each call as
-        CALL_ROWS rows of fixed overhead plus its padded rows (one 1024 call for 300 rows
-        wastes more than a 256 and a 64 cost)."""
-        largest = self.buckets[-1]
-        full, rest = divmod(n, largest)
-        return [largest] * full + (list(_cheapest_cover(rest, self.buckets)) if rest else [])
+        """`piece_sizes` over this caller's buckets."""
+        return piece_sizes(n, self.buckets)

@@ -25,7 +25,7 @@ import numpy as np
 
 from search.backend import Backend, Reply, Request
 from search.chain import Chain
-from search.device_calls import RowsOf
+from search.device_calls import BUCKETS, RowsOf
 from search.dfs import MAX_PORTIONS, Alternatives, depth_first
 from search.jax_backend import JaxBackend
 from search.lockstep import search_in_lockstep
@@ -80,7 +80,7 @@ class Explorer(Searcher):
     backend: JaxBackend
 
     def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, chunk: int = 256, slice_size: int = 256,
-                 buckets: Sequence[int] = (16, 64, 256, 1024, 4096), width: int = 32,
+                 buckets: Sequence[int] = BUCKETS, width: int = 32,
                  devices: Sequence[jax.Device] | None = None):
         super().__init__(JaxBackend(cfg, buckets, width, devices), chunk, slice_size, width)
 

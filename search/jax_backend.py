@@ -24,7 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from search.backend import Reply, Request
-from search.device_calls import DeviceCalls, Pending
+from search.device_calls import BUCKETS, DeviceCalls, Pending
 from search.packing import blackboard_columns, pack_state, packed_field, unpack_blackboard, unpack_state
 from search.stepping import EMPTY_HANDED, loop_needs_iteration, replay_examples, step_examples
 from search.task import Task
@@ -116,7 +116,7 @@ class JaxBackend:
     """The `search.backend.Backend` on the JAX emulator; one instance keeps its compiled
     steps and its bank of up to `width` tasks."""
 
-    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, buckets: Sequence[int] = (16, 64, 256, 1024, 4096),
+    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, buckets: Sequence[int] = BUCKETS,
                  width: int = 32, devices: Sequence[jax.Device] | None = None):
         self.cfg = cfg
         self.calls = DeviceCalls(buckets, devices)  # every batch split by rows over these devices

@@ -224,3 +224,31 @@ def test_the_report_gives_the_learning_benchmark_and_vcc_learns_wall_time():
     text = "\n".join(lines)
     assert "settled by one answered query 1" in text and "cold 50.5 s, warm 9.25 s on 2 cores" in text
     assert "`new.json`" in text and learn_section([]) == []
+
+
+def test_bench_emulator_cuts_batches_as_the_search_does():
+    """Each instruction's children go in the search's padded sizes (its cheapest cover,
+    capped at the bench's batch), every child once; a carry op's holding rows apart."""
+    import numpy as np
+
+    from search.device_calls import BUCKETS, DeviceCalls
+    from search.stepping import EMPTY_HANDED
+    from vcc.emulator_bench import _parts, _pieces
+
+    for n, batch in [(1, 1024), (17, 1024), (300, 1024), (658, 1024), (2500, 1024), (70, 64)]:
+        pieces = _pieces(n, batch)
+        calls = DeviceCalls([b for b in BUCKETS if b < batch] + [batch])
+        assert [len(p) for p in pieces] == calls.piece_sizes(n)
+        assert sorted(set(np.concatenate(pieces).tolist())) == list(range(n))
+        assert all(len(p) <= batch and set(p.tolist()) <= set(range(n)) for p in pieces)
+
+    class Hand:  # rows 1 and 3 hold an object on some example
+        held = np.array([[-1, -1], [-1, 2], [-1, -1], [0, 0]])
+
+    class States:
+        hand = Hand
+
+    group = {"rows": np.arange(4), "states": States}
+    carry = next(iter(EMPTY_HANDED))
+    assert [p.tolist() for p in _parts(carry, group)] == [[1, 3], [0, 2]]
+    assert [p.tolist() for p in _parts(-1, group)] == [[0, 1, 2, 3]]

@@ -58,6 +58,7 @@ def _lines(c: SceneConst, s: VCCState, cfg: VCCConfig, axis: int):
     axis 0: lines are rows, runs are columns; axis 1: lines are columns, runs are rows.
     """
     table, start = (c.runs, c.corner[:, 0]) if axis == 0 else (c.cruns, c.corner[:, 1])
+    table = table.astype(jnp.int32)  # stored as int16 (state.RUN_DTYPE)
     off = s.blackboard.offset
     line_off, run_off = (off[:, 1], off[:, 0]) if axis == 0 else (off[:, 0], off[:, 1])
     lines = (start + line_off)[:, None] + jnp.arange(cfg.mask_rows, dtype=jnp.int32)[None, :]
@@ -97,7 +98,7 @@ def contains(c: SceneConst, s: VCCState, cfg: VCCConfig, point: jax.Array) -> ja
     b = s.blackboard
     k = row - (c.corner[:, 0] + b.offset[:, 1])
     ok = (k >= 0) & (k < cfg.mask_rows) & b.alive
-    runs = c.runs[jnp.arange(cfg.n_max), jnp.clip(k, 0, cfg.mask_rows - 1)]
+    runs = c.runs[jnp.arange(cfg.n_max), jnp.clip(k, 0, cfg.mask_rows - 1)].astype(jnp.int32)
     x = col - b.offset[:, 0]
     inside = ((x >= runs[:, 0]) & (x <= runs[:, 1])) | ((x >= runs[:, 2]) & (x <= runs[:, 3]))
     return ok & inside

@@ -21,6 +21,12 @@ from vccjax.machine.memories import padded
 from vccjax.machine.scene import Scene, SceneObject, to_units
 
 
+# Mask runs are raster indices (< 512, or the empty run 1, 0): int16 halves what the
+# search's batched steps read when they gather a concept's scenes per program; widened
+# to int32 where they are used.
+RUN_DTYPE = np.int16
+
+
 @struct.dataclass
 class SceneConst:
     n: jax.Array  # () number of objects
@@ -28,8 +34,8 @@ class SceneConst:
     color: jax.Array  # (N,) initial color index
     width: jax.Array  # (N,) float32 width (unit square)
     base: jax.Array  # (N, 2) centre at load, position units (x, y)
-    runs: jax.Array  # (N, K, 4) column runs (lo1, hi1, lo2, hi2) per mask row, from row corner[0]
-    cruns: jax.Array  # (N, K, 4) row runs per mask column, from column corner[1]
+    runs: jax.Array  # (N, K, 4) int16 column runs (lo1, hi1, lo2, hi2) per mask row, from row corner[0]
+    cruns: jax.Array  # (N, K, 4) int16 row runs per mask column, from column corner[1]
     corner: jax.Array  # (N, 2) the mask's top row and left column at load
     box: jax.Array  # (N, 4) pixel offsets keeping the w x w box in the workspace: x min/max, y min/max
     has_pointer: jax.Array  # () bool
@@ -124,7 +130,7 @@ def load_scene(scene: Scene, cfg: VCCConfig = DEFAULT_CONFIG, validate: bool = T
     return SceneConst(
         n=jnp.int32(len(scene.objects)), shape=jnp.asarray(shape), color=jnp.asarray(color),
         width=jnp.asarray(width), base=jnp.asarray(base),
-        runs=jnp.asarray(runs), cruns=jnp.asarray(cruns), corner=jnp.asarray(corner),
+        runs=jnp.asarray(runs, RUN_DTYPE), cruns=jnp.asarray(cruns, RUN_DTYPE), corner=jnp.asarray(corner),
         box=jnp.asarray(box), has_pointer=jnp.bool_(has_ptr),
         pointer=jnp.asarray(ptr, jnp.int32),
     )
@@ -190,7 +196,7 @@ def object_masks(c: SceneConst, s: VCCState, cfg: VCCConfig) -> jax.Array:
     r, b = jnp.arange(cfg.raster), s.blackboard
     k = r[None, :] - (c.corner[:, 0] + b.offset[:, 1])[:, None]  # (N, R) mask row per raster row
     valid = (k >= 0) & (k < cfg.mask_rows) & b.alive[:, None]
-    runs = jnp.take_along_axis(c.runs, jnp.clip(k, 0, cfg.mask_rows - 1)[:, :, None], axis=1)
+    runs = jnp.take_along_axis(c.runs.astype(jnp.int32), jnp.clip(k, 0, cfg.mask_rows - 1)[:, :, None], axis=1)
     runs = runs + b.offset[:, None, None, 0]
     col = r[None, None, :]
     inside = ((col >= runs[..., 0:1]) & (col <= runs[..., 1:2])) | (
