@@ -16,6 +16,8 @@ from robot.sources import Programs
 from vccjax import files
 
 BATCH = 32
+RECORD = {"batch": (int,), "rolled_out": (int,), "non_finite": (int,), "success": (int,), "failures": (dict,),
+          "concepts": (list,), "timing": (dict,)}  # a batch's record: what the summary reads
 
 
 def draw_batch(seed: int, batch: int, programs: Programs, size: int = BATCH) -> list:
@@ -64,7 +66,7 @@ def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: 
     bench = None
     for b in tqdm(range(batches), desc="robot stress", unit="batch"):
         path = out / f"batch-{b:03d}.json"
-        if finished(path, seed=seed, source=programs.source.label(), world_sha256=world_sha256()):
+        if finished(path, RECORD, seed=seed, source=programs.source.label(), world_sha256=world_sha256()):
             continue
         bench = bench or Bench()
         items = draw_batch(seed, b, programs)
@@ -80,8 +82,7 @@ def run_stress(out: str | Path, programs: Programs, rollouts: int = 1000, seed: 
         write_record(path, record)
         log(f"batch {b}: {record['success']} of {len(items)} carried out, "
             f"{record['non_finite']} non-finite, wall {info['wall_s']:.0f} s")
-    rows = [read_record(out / f"batch-{b:03d}.json", {"rolled_out": (int,), "success": (int,)})
-            for b in range(batches)]
+    rows = [read_record(out / f"batch-{b:03d}.json", RECORD) for b in range(batches)]
     summary = {"seed": seed, "batches": batches, "rollouts": batches * BATCH,
                "rolled_out": sum(r["rolled_out"] for r in rows),
                "non_finite": sum(r["non_finite"] for r in rows),

@@ -49,14 +49,15 @@ def read_record(path: Path, schema: dict | None = None) -> dict:
     return check_fields(read_json(path, DataFileError, "missing"), schema, str(path))
 
 
-def finished(path: Path, **expected) -> bool:
-    """Whether `path` holds a record made with these settings (a resume keeps it; one
-    made with other settings is redone, not mixed in). A source matches on its kind and
-    folder: its hash is kept as provenance, and a run or library that gained other
-    concepts leaves this one's record good (`program_sha256` says what ran)."""
+def finished(path: Path, schema: dict | None = None, **expected) -> bool:
+    """Whether `path` holds a record (of `schema`, as `read_record`) made with these
+    settings (a resume keeps it; one made with other settings is redone, not mixed in).
+    A source matches on its kind and folder: its hash is kept as provenance, and a run or
+    library that gained other concepts leaves this one's record good (`program_sha256`
+    says what ran)."""
     if not path.exists():
         return False
-    record = read_record(path)
+    record = read_record(path, schema)
     for k, v in expected.items():
         got = record.get(k)
         if k == "source" and isinstance(got, dict):

@@ -134,3 +134,33 @@ def test_a_concept_saved_by_vcc_learn_is_carried_out_by_name(tmp_path, monkeypat
     assert "recolours an object" in capsys.readouterr().err
     assert main(["robot", "run", "--concept", "no_such_saved"]) == 2
     assert "not in your library" in capsys.readouterr().err
+
+
+def test_stress_resumes_from_its_batch_records_without_redoing_them(tmp_path, monkeypatch):
+    """`vcc robot stress` stopped after some batches: run again, it keeps the finished
+    batches (redrawing nothing) and runs only the rest; a batch of another seed is redone."""
+    import json
+
+    import robot.rollout
+    from robot.judge import Verdict
+    from robot.sources import Programs
+    from robot.stress import BATCH, run_stress
+
+    calls = []
+
+    class FakeBench:
+        def run_pairs(self, items, keep=False, pad_to=None):
+            calls.append(len(items))
+            vs = [Verdict(True, None, "", 0.0, s.seed) for _, s in items]
+            return vs, {"compile_s": 0.0, "rollout_s": 0.0}, [None] * len(items)
+
+    monkeypatch.setattr(robot.rollout, "Bench", FakeBench)
+    reference = Programs("reference")
+    s = run_stress(tmp_path, reference, rollouts=BATCH, seed=3, log=lambda _: None)
+    assert calls == [BATCH] and s["success"] == BATCH and s["batches"] == 1
+    s = run_stress(tmp_path, reference, rollouts=2 * BATCH, seed=3, log=lambda _: None)
+    assert calls == [BATCH, BATCH] and s["success"] == 2 * BATCH  # batch 0 kept, batch 1 run
+    kept = json.loads((tmp_path / "batch-000.json").read_text())
+    assert kept["seed"] == 3 and len(kept["concepts"]) == BATCH
+    run_stress(tmp_path, reference, rollouts=BATCH, seed=4, log=lambda _: None)
+    assert calls == [BATCH, BATCH, BATCH]  # another seed: redone
