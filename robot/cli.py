@@ -72,7 +72,7 @@ def cmd_run(a: argparse.Namespace) -> int:
             "concept": a.concept,
             "program": [p.text() for p in (program if isinstance(program, list) else [program])],
             "scenarios": a.scenarios, "seed": a.seed,
-            "success": ok, "timing": info, "verdicts": [v.__dict__ for v in verdicts]})
+            "success": ok, "timing": info, "verdicts": [v.record() for v in verdicts]})
     print(f"success: {ok} of {len(verdicts)} ({ok / max(1, len(verdicts)):.1%})")
     return 0
 

@@ -38,6 +38,10 @@ class Verdict:
     seed: int
     parse: dict | None = None  # the parse against the truth (`robot.truth.ParseCheck.record`), when parsed
 
+    def record(self) -> dict:
+        """The verdict as strict JSON: a placement error not measured (nan) is null."""
+        return {k: (None if isinstance(v, float) and v != v else v) for k, v in self.__dict__.items()}
+
 
 def _slot_xyz(model: mujoco.MjModel, q: np.ndarray) -> np.ndarray:
     """(..., slots, 3) body positions from recorded qpos (..., nq)."""
@@ -124,4 +128,4 @@ def tally(verdicts: list[Verdict]) -> dict:
 
     return {"success": sum(v.success for v in verdicts),
             "failures": dict(Counter(v.cause for v in verdicts if not v.success)),
-            "verdicts": [v.__dict__ for v in verdicts]}
+            "verdicts": [v.record() for v in verdicts]}

@@ -144,18 +144,13 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
             record = {"concept": name, **settings(name), "programs": texts, "batch": {"concepts": group, **info},
                       "success": sum(v.success for v in runs),
                       "failures": dict(Counter(v.cause for v in runs if not v.success)),
-                      "records": [_plain(v.__dict__) for v in runs]}
+                      "records": [v.record() for v in runs]}
             write_record(file_of(out, name), record)
             log(f"{name}: {record['success']} of {scenarios}")
             bar.update(1)
         summarise(out, programs, concepts, scenarios, seed)  # a partial run reads as far as it went
     bar.close()
     return summarise(out, programs, concepts, scenarios, seed)
-
-
-def _plain(d: dict) -> dict:
-    """A record as strict JSON: a placement error not measured (nan) is null."""
-    return {k: (None if isinstance(v, float) and v != v else v) for k, v in d.items()}
 
 
 def summarise(out: Path, programs: Programs, concepts: Sequence[str], scenarios: int, seed: int) -> dict:

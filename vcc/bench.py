@@ -43,6 +43,11 @@ def _search_jobs(a: argparse.Namespace):
     vocab = Vocabulary()
     if a.model == "uniform":
         model = MarkovModel.uniform(vocab.size, 1)
+    elif a.model == "library":  # what explore-compress learned: its model and subroutines, as vcc learn starts
+        from search.library import load
+
+        lib = load(None)
+        vocab, model = lib.vocab, lib.model
     else:  # a late explore-compress iteration's model, stood in for by the reference programs
         model = MarkovModel.fit([list(p.ops) for p in all_concepts().values()], vocab.size, 1, 0.1)
     settings = Settings(args="oracle")
@@ -246,9 +251,10 @@ def add_commands(sub) -> None:
     _concept_flags(s, 64)
     s.add_argument("--budget", type=runtime.count(1, 10**10), default=100_000,
                    help="programs per concept (default 100000)")
-    s.add_argument("--model", choices=["uniform", "reference"], default="uniform",
+    s.add_argument("--model", choices=["uniform", "reference", "library"], default="uniform",
                    help="uniform: explore-compress iteration 0; reference: an order-1 model fitted "
-                        "on the reference programs, standing in for a late iteration (deeper trees)")
+                        "on the reference programs, standing in for a late iteration (deeper trees); "
+                        "library: the shipped library (model and subroutines), as vcc learn searches")
     s.add_argument("--width", type=runtime.count(1, 4096), default=32, help="concepts in lockstep (default 32)")
     s.add_argument("--out", default="benchmarks/results/search.json", type=runtime.out_file(".json"),
                    help="result JSON")

@@ -138,7 +138,8 @@ def test_a_concept_saved_by_vcc_learn_is_carried_out_by_name(tmp_path, monkeypat
 
 def test_stress_resumes_from_its_batch_records_without_redoing_them(tmp_path, monkeypatch):
     """`vcc robot stress` stopped after some batches: run again, it keeps the finished
-    batches (redrawing nothing) and runs only the rest; a batch of another seed is redone."""
+    batches (redrawing nothing) and runs only the rest; a batch of another seed is redone.
+    A scenario not run (no placement error measured) is recorded, not a crash."""
     import json
 
     import robot.rollout
@@ -150,17 +151,19 @@ def test_stress_resumes_from_its_batch_records_without_redoing_them(tmp_path, mo
 
     class FakeBench:
         def run_pairs(self, items, keep=False, pad_to=None):
-            calls.append(len(items))
-            vs = [Verdict(True, None, "", 0.0, s.seed) for _, s in items]
+            calls.append(len(items))  # the first scenario not run (its error not measured: nan)
+            vs = [Verdict(k > 0, None if k else "no scenario", "", 0.0 if k else float("nan"), s.seed)
+                  for k, (_, s) in enumerate(items)]
             return vs, {"compile_s": 0.0, "rollout_s": 0.0}, [None] * len(items)
 
     monkeypatch.setattr(robot.rollout, "Bench", FakeBench)
     reference = Programs("reference")
     s = run_stress(tmp_path, reference, rollouts=BATCH, seed=3, log=lambda _: None)
-    assert calls == [BATCH] and s["success"] == BATCH and s["batches"] == 1
+    assert calls == [BATCH] and s["success"] == BATCH - 1 and s["batches"] == 1
     s = run_stress(tmp_path, reference, rollouts=2 * BATCH, seed=3, log=lambda _: None)
-    assert calls == [BATCH, BATCH] and s["success"] == 2 * BATCH  # batch 0 kept, batch 1 run
-    kept = json.loads((tmp_path / "batch-000.json").read_text())
-    assert kept["seed"] == 3 and len(kept["concepts"]) == BATCH
+    assert calls == [BATCH, BATCH] and s["success"] == 2 * (BATCH - 1)  # batch 0 kept, batch 1 run
+    assert s["failures"] == {"no scenario": 2}
+    kept = json.loads((tmp_path / "batch-000.json").read_text())  # strict JSON: the nan is null
+    assert kept["seed"] == 3 and len(kept["concepts"]) == BATCH and kept["verdicts"][0]["max_error_m"] is None
     run_stress(tmp_path, reference, rollouts=BATCH, seed=4, log=lambda _: None)
     assert calls == [BATCH, BATCH, BATCH]  # another seed: redone

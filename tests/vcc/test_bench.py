@@ -252,3 +252,20 @@ def test_bench_emulator_cuts_batches_as_the_search_does():
     carry = next(iter(EMPTY_HANDED))
     assert [p.tolist() for p in _parts(carry, group)] == [[1, 3], [0, 2]]
     assert [p.tolist() for p in _parts(-1, group)] == [[0, 1, 2, 3]]
+
+
+def test_bench_search_can_start_from_the_shipped_library():
+    """`--model library`: the chains search with the shipped library's vocabulary
+    (atoms and subroutines) and model, as `vcc learn` does."""
+    import numpy as np
+
+    from search.library import load
+    from vcc.bench import _search_jobs
+
+    a = build_parser().parse_args(["bench", "search", "--concepts", "remove_bottom_obj", "--model", "library"])
+    names, jobs = _search_jobs(a)
+    lib = load(None)
+    (chain, task), = jobs
+    assert names == ["remove_bottom_obj"] and task.n_examples >= 1
+    assert chain.vocab == lib.vocab and lib.vocab.bodies  # the library's subroutines, not the atoms alone
+    assert np.array_equal(chain.model.logp, lib.model.logp)
