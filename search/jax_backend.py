@@ -225,11 +225,14 @@ class JaxBackend:
                        rows: np.ndarray) -> list[np.ndarray]:
         """`rows` split into those where some example holds an object (their states are
         `source[source_rows]`) and the rest, for a carry op (the rest then skip the carry:
-        `stepping.EMPTY_HANDED`)."""
+        `stepping.EMPTY_HANDED`), when that makes the carrying calls smaller: padded to
+        the same sizes, the split would only add a call."""
         if op not in EMPTY_HANDED:
             return [rows]
         holding = _holding_rows(source, source_rows, self.cfg)
-        return [part for part in (rows[holding], rows[~holding]) if len(part)]
+        if sum(self.calls.piece_sizes(int(holding.sum()))) < sum(self.calls.piece_sizes(len(rows))):
+            return [part for part in (rows[holding], rows[~holding]) if len(part)]
+        return [rows]
 
     def _replay_loops(self, slots: np.ndarray, states: np.ndarray, rows: np.ndarray) -> None:
         """A closed loop's remaining iterations for `states[rows]`, one body instruction at a
