@@ -7,8 +7,8 @@ number of concepts); a batch's rows are programs, each reading its concept's slo
 On the host a prefix's states are one packed int32 row per example (`search.packing`),
 so a frame is one array and a transfer one copy. A request's children are stepped
 atom by atom (a subroutine is several), each atom's rows grouped by instruction; a
-closed loop's further iterations are replayed on the host's command one body
-instruction at a time (`_replay_loops`). Complete programs are judged on the device.
+closed loop's further iterations are replayed in one device call per piece of rows
+(`_replay_loops`). Complete programs are judged on the device.
 
 This module is the only part of the search that reads the machine state's fields
 (the section "the machine state's fields" below).
@@ -26,7 +26,7 @@ import numpy as np
 from search.backend import Reply, Request
 from search.device_calls import BUCKETS, DeviceCalls, Pending
 from search.packing import blackboard_columns, pack_state, packed_field, unpack_blackboard, unpack_state
-from search.stepping import EMPTY_HANDED, loop_needs_iteration, replay_examples, step_examples
+from search.stepping import EMPTY_HANDED, replay_loops, step_examples
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.instructions import OP
@@ -49,13 +49,6 @@ def _failed_rows(packed: np.ndarray, rows: np.ndarray, cfg: VCCConfig) -> np.nda
 def _holding_rows(packed: np.ndarray, rows: np.ndarray, cfg: VCCConfig) -> np.ndarray:
     """(len(rows),) whether some example of packed rows `rows` holds an object."""
     return (packed_field(packed, "hand.held", cfg)[rows] >= 0).any(axis=1)
-
-
-def _loop_bodies(packed: np.ndarray, cfg: VCCConfig) -> tuple[np.ndarray, ...]:
-    """Of packed rows with a just-closed loop: its body's ops and args (n, L), length and
-    first pc (n,) (the same on every example: read on the first)."""
-    control = unpack_state(packed, cfg).control
-    return control.body_ops[:, 0], control.body_args[:, 0], control.body_len[:, 0], control.body_pc0[:, 0]
 
 
 def _blackboards(packed: np.ndarray, cfg: VCCConfig) -> np.ndarray:
@@ -83,10 +76,10 @@ def _advance(cfg: VCCConfig, op: int, consts: SceneConst, slots, packed, args, r
     return pack_state(new, cfg), _failed_anywhere(new)
 
 
-@functools.partial(jax.jit, static_argnums=(0, 1))
-def _replay_op(cfg: VCCConfig, op: int, consts: SceneConst, slots, packed, args, pcs, active):
-    """`replay_examples` on packed states."""
-    return pack_state(replay_examples(cfg, op, consts, slots, unpack_state(packed, cfg), args, pcs, active), cfg)
+@functools.partial(jax.jit, static_argnums=0)
+def _replay_packed(cfg: VCCConfig, consts: SceneConst, slots, packed):
+    """`replay_loops` on packed states."""
+    return pack_state(replay_loops(cfg, consts, slots, unpack_state(packed, cfg)), cfg)
 
 
 @functools.lru_cache(maxsize=None)
@@ -235,38 +228,13 @@ class JaxBackend:
         return [rows]
 
     def _replay_loops(self, slots: np.ndarray, states: np.ndarray, rows: np.ndarray) -> None:
-        """A closed loop's remaining iterations for `states[rows]`, one body instruction at a
-        time, each group of programs stepped with that instruction's code only (in place)."""
-        cfg = self.cfg
-        body_ops, body_args, body_len, body_pc0 = _loop_bodies(states[rows], cfg)  # fixed once closed
-        active = np.zeros(states.shape[:2], bool)  # (all rows, E)
-        args = np.zeros(len(states), np.int32)  # this body position's, read at `rows` only
-        pcs = np.zeros(len(states), np.int32)
-        iteration = 1
-        while True:
-            active[rows] = loop_needs_iteration(cfg, unpack_state(states[rows], cfg), iteration)  # host
-            iterating = active[rows].any(axis=1)
-            if not iterating.any():
-                return
-            for j in range(int(body_len[iterating].max())):
-                live = iterating & (body_len > j)
-                pending = []  # the groups of body position j, all started before any is waited for
-                for op in np.unique(body_ops[live, j]):
-                    group = np.nonzero(live & (body_ops[:, j] == op))[0]
-                    args[rows[group]], pcs[rows[group]] = body_args[group, j], body_pc0[group] + j
-                    for part in self._holding_parts(int(op), states, rows[group], rows[group]):
-                        pending += self._start_replay(slots, states, int(op), part, args, pcs, active)
-                for done_rows, new in self.calls.results(pending):
-                    states[done_rows] = new
-            iteration += 1
-
-    def _start_replay(self, slots: np.ndarray, states: np.ndarray, op: int, rows: np.ndarray, args: np.ndarray,
-                      pcs: np.ndarray, active: np.ndarray) -> Pending:
+        """A closed loop's remaining iterations for `states[rows]` (in place), each piece of
+        rows in one device call (`stepping.replay_loops`)."""
         cfg, (consts, _) = self.cfg, self._bank
-        return self.calls.start(
-            ("replay", op, active.shape[1]), rows,
-            lambda rows_of: _replay_op(cfg, op, consts, rows_of(slots), rows_of(states), rows_of(args), rows_of(pcs),
-                                       rows_of(active)))
+        for done_rows, new in self.calls.run(
+                ("replay", states.shape[1]), rows,
+                lambda rows_of: _replay_packed(cfg, consts, rows_of(slots), rows_of(states))):
+            states[done_rows] = new
 
     def _children_room(self, shape: tuple, dtype) -> np.ndarray:
         """Room for a round's children, reused from round to round (a fresh array each round

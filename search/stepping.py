@@ -3,8 +3,9 @@ example scenes, stepped by one static instruction per device call.
 
 A search holds (B, E) states, B programs times E examples; `step_examples` steps them
 all by one op. Loops: with replay=False a `loop_end` only closes the loop and the
-caller replays its body one static instruction at a time (`loop_needs_iteration`,
-`replay_examples`), instead of tracing every instruction's code in a loop.
+caller replays its body with `replay_loops`: every further iteration in one device
+call, each body instruction run by its own code only (`replay_examples`), instead of
+tracing every instruction's code per row.
 """
 
 from __future__ import annotations
@@ -97,3 +98,50 @@ def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Arra
         return _per_task(consts, one, (None, None, 0))
 
     return _batched(cfg, op, per_program, tasks, states, args, pcs, active)
+
+
+BODY_OPS = OP["loop_start"]  # ops 0 .. BODY_OPS - 1 may be recorded in a loop body (docs/vcc.md section 5)
+
+
+@functools.partial(jax.jit, static_argnums=0)
+def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState) -> VCCState:
+    """Every further iteration of the loops just closed in (B, E) states (a `loop_end`
+    stepped with replay=False), in one device call. Per iteration (while
+    `loop_needs_iteration` holds for some row) and per body position, each instruction
+    that some row has there runs by a switch on an unbatched index, so only its code
+    runs, for the rows that have it (`replay_examples`): the host's replay of one call
+    per (iteration, position, instruction), without the host round trips."""
+    ctl = states.control
+    ops, args = ctl.body_ops[:, 0], ctl.body_args[:, 0]  # (B, L): a body is the same on every example
+    length, pc0 = ctl.body_len[:, 0], ctl.body_pc0[:, 0]
+
+    def branch(op):
+        def run(s, j, here, active):
+            return replay_examples(cfg, op, consts, tasks, s, args[:, j], pc0 + j, active & here[:, None])
+        return run
+
+    branches = [branch(op) for op in range(BODY_OPS)]
+
+    def iterate(carry):
+        it, s = carry
+        active = loop_needs_iteration(cfg, s, it)  # (B, E), fixed for this iteration
+        live_rows = active.any(axis=1)
+
+        def position(j, s):
+            live = live_rows & (length > j)
+
+            def one_op(k, s):
+                here = live & (ops[:, j] == k)
+                return jax.lax.cond(here.any(), lambda s: jax.lax.switch(k, branches, s, j, here, active),
+                                    lambda s: s, s)
+
+            return jax.lax.fori_loop(0, BODY_OPS, one_op, s)
+
+        steps = jnp.max(jnp.where(live_rows, length, 0))
+        return it + 1, jax.lax.fori_loop(0, steps, position, s)
+
+    def more(carry):
+        it, s = carry
+        return jnp.any(loop_needs_iteration(cfg, s, it))
+
+    return jax.lax.while_loop(more, iterate, (jnp.int32(1), states))[1]

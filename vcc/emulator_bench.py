@@ -26,7 +26,7 @@ import numpy as np
 
 from vccjax.machine.config import VCCConfig
 from search.device_calls import BUCKETS, piece_sizes
-from search.stepping import EMPTY_HANDED, loop_needs_iteration, replay_examples, step_examples
+from search.stepping import EMPTY_HANDED, replay_loops, step_examples
 from vccjax.machine.step import run_batch
 from vccjax.machine.instructions import NAMES, OP
 from vccjax.machine.program import Program
@@ -170,29 +170,12 @@ def step_jax(p: Prepared, prepared: dict[int, list]) -> tuple[dict[int, list], d
 
 
 def _step(cfg: VCCConfig, op: int, consts, tasks, states, args):
-    """As the search steps: a closed loop's further iterations are replayed one body
-    instruction at a time with that instruction's code only (`JaxBackend._replay_loops`), not in
-    a traced loop that runs every instruction's code."""
+    """As the search steps: a closed loop's further iterations are replayed in one more
+    call (`stepping.replay_loops`, each body instruction by its own code), not in a
+    traced loop that runs every instruction's code."""
     if op != OP["loop_end"]:
         return step_examples(cfg, op, consts, tasks, states, args)
-    states = step_examples(cfg, op, consts, tasks, states, args, False)
-    control = states.control
-    ops, body_args = np.asarray(control.body_ops[:, 0]), np.asarray(control.body_args[:, 0])
-    length, pc0 = np.asarray(control.body_len[:, 0]), np.asarray(control.body_pc0[:, 0])
-    iteration = 1
-    while True:
-        active = np.asarray(loop_needs_iteration(cfg, states, iteration))  # (B, E)
-        rows = active.any(axis=1)
-        if not rows.any():
-            return states
-        for j in range(int(length[rows].max())):
-            live = rows & (length > j)
-            for o in np.unique(ops[live, j]):
-                here = live & (ops[:, j] == o)
-                arg = jnp.asarray(np.where(here, body_args[:, j], 0))
-                states = replay_examples(cfg, int(o), consts, tasks, states, arg, jnp.asarray(pc0 + j),
-                                         jnp.asarray(active & here[:, None]))
-        iteration += 1
+    return replay_loops(cfg, consts, tasks, step_examples(cfg, op, consts, tasks, states, args, False))
 
 
 def step_reference(p: Prepared) -> tuple[list[list[RefMachine]], dict[int, float]]:

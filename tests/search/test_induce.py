@@ -41,7 +41,7 @@ def _uniform_chain():
 
 def _loop_chain():
     """A model that likes loops (fitted on the reference programs: only to make loops
-    likely here) so that `loop_end` and its host-driven replay are exercised."""
+    likely here) so that `loop_end` and its replay (`stepping.replay_loops`) are exercised."""
     from vccjax.world.concepts import all_concepts
 
     v = Vocabulary()
@@ -60,7 +60,7 @@ def test_batched_and_scalar_search_visit_the_same_tree(ds, explorer, concept):
     assert a.programs <= 20_000
 
 
-def test_loops_replayed_on_the_host_agree_with_the_scalar_search(ds, explorer):
+def test_loops_replayed_on_the_device_agree_with_the_scalar_search(ds, explorer):
     """Loops under a model that likes them (`_loop_chain`)."""
     chain = _loop_chain()
     task = Task.from_pairs(ds.pairs(LOOP, "train"))
