@@ -65,8 +65,8 @@ def step_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Array,
     each program belongs to; states: (B, E, ...); args: (B,). Programs of many concepts
     step in one call, so a search over many concepts makes large batches. With
     replay=False a `loop_end` only closes the loop: the caller replays the body
-    with `loop_needs_iteration` and `replay_examples` (one static op at a time, instead
-    of every instruction's code in a traced loop)."""
+    with `replay_loops` (each body instruction by its own code, instead of every
+    instruction's code in a traced loop)."""
 
     def per_program(fn):
         def one(c, s, arg):
