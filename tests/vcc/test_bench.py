@@ -269,3 +269,22 @@ def test_bench_search_can_start_from_the_shipped_library():
     assert names == ["remove_bottom_obj"] and task.n_examples >= 1
     assert chain.vocab == lib.vocab and lib.vocab.bodies  # the library's subroutines, not the atoms alone
     assert np.array_equal(chain.model.logp, lib.model.logp)
+
+
+def test_bench_search_scalar_side_can_run_a_sample(tmp_path, capsys):
+    """`--scalar-sample k`: the scalar side searches k of the concepts, evenly spread; the
+    results are compared on those, and the ratio is of programs run per second."""
+    from vcc.bench import scalar_sample
+
+    assert scalar_sample(64, 4) == [0, 16, 32, 48] and scalar_sample(3, 5) == [0, 1, 2] == scalar_sample(3, None)
+    assert len(scalar_sample(7, 3)) == 3 and len(set(scalar_sample(10, 10))) == 10
+    out = tmp_path / "search.json"
+    argv = ["bench", "search", "--concepts", "remove_bottom_obj,change_all_objs_color", "--budget", "2000",
+            "--width", "2", "--scalar-sample", "1", "--out", str(out)]
+    assert main(argv) == 0
+    r = json.loads(out.read_text())
+    assert r["scalar"]["concepts"] == ["remove_bottom_obj"] and r["results_agree"] is True
+    b, s = r["batched"], r["scalar"]
+    expected = (b["programs_run"] / b["seconds"]) / (s["programs_run"] / s["seconds"])
+    assert abs(r["ratio"] - expected) <= 0.03 * expected + 0.01  # from the seconds as stored (rounded)
+    assert "scalar over 1" in capsys.readouterr().out
