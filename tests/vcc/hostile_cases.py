@@ -563,6 +563,9 @@ case("bench-search-budget-zero", "bench", "search", *_flags(BS, budget="0"), wri
 case("bench-search-budget-negative", "bench", "search", *_flags(BS, budget="-1"), writes=W_BS, slow=True)
 case("bench-search-width-zero", "bench", "search", *_flags(BS, width="0"), writes=W_BS, slow=True)
 case("bench-search-width-negative", "bench", "search", *_flags(BS, width="-1"), writes=W_BS, slow=True)
+case("bench-search-scalar-sample-zero", "bench", "search", *_flags(BS, scalar_sample="0"), writes=W_BS)
+case("bench-search-scalar-sample-text", "bench", "search", *_flags(BS, scalar_sample="half"), writes=W_BS,
+     slow=True)
 for name in ("flipped", "manifest_list", "nan_coords", "shape_index"):
     case(f"bench-search-dataset-{name.replace('_', '-')}", "bench", "search",
          *_flags(BS, dataset=f"{{tmp}}/ds/{name}"), setup="ds", writes=W_BS)
