@@ -26,7 +26,7 @@ import numpy as np
 from search.backend import Reply, Request
 from search.device_calls import BUCKETS, DeviceCalls, Pending
 from search.packing import blackboard_columns, pack_state, packed_field, unpack_blackboard, unpack_state
-from search.stepping import EMPTY_HANDED, replay_loops, step_examples
+from search.stepping import EMPTY_HANDED, holding_split, replay_loops, step_examples
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.instructions import OP
@@ -216,16 +216,10 @@ class JaxBackend:
 
     def _holding_parts(self, op: int, source: np.ndarray, source_rows: np.ndarray,
                        rows: np.ndarray) -> list[np.ndarray]:
-        """`rows` split into those where some example holds an object (their states are
-        `source[source_rows]`) and the rest, for a carry op (the rest then skip the carry:
-        `stepping.EMPTY_HANDED`), when that makes the carrying calls smaller: padded to
-        the same sizes, the split would only add a call."""
+        """`rows` (states `source[source_rows]`) cut as `stepping.holding_split` says."""
         if op not in EMPTY_HANDED:
             return [rows]
-        holding = _holding_rows(source, source_rows, self.cfg)
-        if sum(self.calls.piece_sizes(int(holding.sum()))) < sum(self.calls.piece_sizes(len(rows))):
-            return [part for part in (rows[holding], rows[~holding]) if len(part)]
-        return [rows]
+        return holding_split(op, rows, _holding_rows(source, source_rows, self.cfg), self.calls.piece_sizes)
 
     def _replay_loops(self, slots: np.ndarray, states: np.ndarray, rows: np.ndarray) -> None:
         """A closed loop's remaining iterations for `states[rows]` (in place), each piece of

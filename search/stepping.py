@@ -11,9 +11,11 @@ tracing every instruction's code per row.
 from __future__ import annotations
 
 import functools
+from typing import Callable
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from vccjax.machine.config import VCCConfig
 from vccjax.machine.instructions import OP
@@ -34,6 +36,17 @@ EMPTY_HANDED = {
     OP["move_hand_to_pointer"]: _fails_empty_handed,
     OP["move_hand_to_fixate_collision"]: _fails_empty_handed,
 }
+
+
+def holding_split(op: int, rows: np.ndarray, holding: np.ndarray,
+                  piece_sizes: Callable[[int], list[int]]) -> list[np.ndarray]:
+    """`rows` split into those where some example holds an object (`holding`, one bool per
+    row) and the rest, for a carry op (the rest then skip the carry: `EMPTY_HANDED`),
+    when that makes the carrying calls smaller: padded to the same sizes, the split
+    would only add a call. Shared by the search and the emulator benchmark."""
+    if op not in EMPTY_HANDED or sum(piece_sizes(int(holding.sum()))) >= sum(piece_sizes(len(rows))):
+        return [rows]
+    return [part for part in (rows[holding], rows[~holding]) if len(part)]
 
 
 def _batched(cfg: VCCConfig, op: int, make, first, states, *rest):

@@ -26,7 +26,7 @@ import numpy as np
 
 from vccjax.machine.config import VCCConfig
 from search.device_calls import BUCKETS, piece_sizes
-from search.stepping import EMPTY_HANDED, replay_loops, step_examples
+from search.stepping import EMPTY_HANDED, holding_split, replay_loops, step_examples
 from vccjax.machine.step import run_batch
 from vccjax.machine.instructions import NAMES, OP
 from vccjax.machine.program import Program
@@ -123,26 +123,30 @@ def prepare(children, scenes: list[list[Scene]], cfg: VCCConfig) -> Prepared:
     return Prepared(cfg, scenes, list(children), refs, consts, groups)
 
 
+def _buckets(batch: int) -> list[int]:
+    """The search's bucket sizes, capped at `batch`."""
+    return [b for b in BUCKETS if b < batch] + [batch]
+
+
 def _pieces(n: int, batch: int) -> list[np.ndarray]:
     """Row indices in pieces as the search cuts a batch of n rows (its bucket sizes up to
     `batch`, at the least padded-rows-plus-calls cost), each padded by repeating its first
     row (one compile per size)."""
     out, s = [], 0
-    for size in piece_sizes(n, [b for b in BUCKETS if b < batch] + [batch]):
+    for size in piece_sizes(n, _buckets(batch)):
         idx = np.arange(s, min(n, s + size))
         out.append(np.concatenate([idx, np.full(size - len(idx), idx[0])]))
         s += size
     return out
 
 
-def _parts(op: int, g: dict) -> list[np.ndarray]:
-    """A group's rows as the search splits them: for a carry op, the rows where some
-    example holds an object apart from the rest, which skip the carry (`EMPTY_HANDED`)."""
+def _parts(op: int, g: dict, batch: int) -> list[np.ndarray]:
+    """A group's rows as the search splits them (`stepping.holding_split`)."""
     rows = np.arange(len(g["rows"]))
     if op not in EMPTY_HANDED:
         return [rows]
     holding = (np.asarray(g["states"].hand.held) >= 0).any(axis=1)
-    return [part for part in (rows[holding], rows[~holding]) if len(part)]
+    return holding_split(op, rows, holding, lambda n: piece_sizes(n, _buckets(batch)))
 
 
 def batches(p: Prepared, batch: int) -> dict[int, list]:
@@ -152,7 +156,7 @@ def batches(p: Prepared, batch: int) -> dict[int, list]:
     out = {}
     for op, g in p.groups.items():
         out[op] = [(idx, g["tasks"][idx], jax.tree.map(lambda a, idx=idx: a[idx], g["states"]), g["args"][idx])
-                   for part in _parts(op, g) for idx in (part[k] for k in _pieces(len(part), batch))]
+                   for part in _parts(op, g, batch) for idx in (part[k] for k in _pieces(len(part), batch))]
     return jax.block_until_ready(out)
 
 

@@ -228,7 +228,8 @@ def test_the_report_gives_the_learning_benchmark_and_vcc_learns_wall_time():
 
 def test_bench_emulator_cuts_batches_as_the_search_does():
     """Each instruction's children go in the search's padded sizes (its cheapest cover,
-    capped at the bench's batch), every child once; a carry op's holding rows apart."""
+    capped at the bench's batch), every child once; a carry op's holding rows apart when
+    that makes the carrying calls smaller, as the search splits them."""
     import numpy as np
 
     from search.device_calls import BUCKETS, DeviceCalls
@@ -242,16 +243,28 @@ def test_bench_emulator_cuts_batches_as_the_search_does():
         assert sorted(set(np.concatenate(pieces).tolist())) == list(range(n))
         assert all(len(p) <= batch and set(p.tolist()) <= set(range(n)) for p in pieces)
 
-    class Hand:  # rows 1 and 3 hold an object on some example
-        held = np.array([[-1, -1], [-1, 2], [-1, -1], [0, 0]])
+    def group_of(held):
+        class Hand:
+            pass
 
-    class States:
-        hand = Hand
+        class States:
+            hand = Hand
 
-    group = {"rows": np.arange(4), "states": States}
+        Hand.held = np.asarray(held)
+        return {"rows": np.arange(len(held)), "states": States}
+
     carry = next(iter(EMPTY_HANDED))
-    assert [p.tolist() for p in _parts(carry, group)] == [[1, 3], [0, 2]]
-    assert [p.tolist() for p in _parts(-1, group)] == [[0, 1, 2, 3]]
+    # 4 rows, rows 1 and 3 holding on some example: both halves pad to one 16-row call,
+    # as the whole does, so splitting would only add a call.
+    small = group_of([[-1, -1], [-1, 2], [-1, -1], [0, 0]])
+    assert [p.tolist() for p in _parts(carry, small, 1024)] == [[0, 1, 2, 3]]
+    # 40 rows (three 16-row calls), 10 holding (one 16-row call): the carry runs on 16
+    # padded rows instead of 48, so the holding rows go apart.
+    held = [[-1, 0] if r % 4 == 0 else [-1, -1] for r in range(40)]
+    big = group_of(held)
+    assert [p.tolist() for p in _parts(carry, big, 1024)] == [list(range(0, 40, 4)),
+                                                             [r for r in range(40) if r % 4]]
+    assert [p.tolist() for p in _parts(-1, big, 1024)] == [list(range(40))]
 
 
 def test_bench_search_can_start_from_the_shipped_library():
