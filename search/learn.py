@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -25,7 +26,8 @@ from search.chain import Chain
 from search.dfs import Alternatives
 from search.explore import Searcher
 from search.model import MarkovModel, Vocabulary
-from search.result import Alternative, Result, program_of
+from search.parts import PartsSettings, learn_in_parts
+from search.result import Alternative, Result, program_of, text_of
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.machine.program import Program
@@ -42,6 +44,7 @@ class LearnSettings:
     library: str = "shipped"  # "shipped", "uniform" (from scratch) or a library file
     rival_margin_nats: float = 6.0  # rivals at most this much less probable than the first
     rival_budget: int = 2_000_000  # programs ranked past the first fit that the rival pass judges
+    parts: int = 3  # when nothing fits, learn in up to this many parts (`search.parts`; 1: never)
     max_rivals: int = 32  # distinct behaviours on the probe scenes
     rival_probes: int = 16  # fresh scenes that tell the rival search's behaviours apart
     fresh_scenes: int = 100
@@ -54,6 +57,8 @@ class LearnSettings:
             raise ValueError(f"--args must be predicted or uniform, got {self.args!r}")
         if self.budget < 1:
             raise ValueError(f"--budget must be positive, got {self.budget}")
+        if not 1 <= self.parts <= 5:
+            raise ValueError(f"--parts must be 1 to 5, got {self.parts}")
         if self.rival_budget < 0 or self.max_rivals < 1 or self.rival_margin_nats < 0 or self.rival_probes < 0:
             raise ValueError("the rival search's budget, margin and count must not be negative")
         if self.fresh_scenes < 1:
@@ -68,6 +73,7 @@ class Learned:
     library: str  # the library's content sha256, or "uniform"
     verdict: Verdict | None  # None when nothing fits
     scenes: list[Scene]  # the fresh scenes the verdict ran on
+    parts: tuple[Program, ...] = ()  # when learned in parts (`search.parts`), each part
 
     @property
     def found(self) -> bool:
@@ -183,7 +189,6 @@ def settle(searched: Result, chain: Chain, pairs: Sequence[tuple[Scene, Scene]],
     budget; the answer picks among them, so one it keeps must not be lost because a fresh
     search from the pairs stops at the budget's cutoff."""
     from search.induce import generalization
-    from search.result import text_of
 
     best = None
     for program in asked:
@@ -202,19 +207,58 @@ def settle(searched: Result, chain: Chain, pairs: Sequence[tuple[Scene, Scene]],
                                text=text_of(chain, portions), dl_nats=nats, dl_bins=bins, rank=rank)
 
 
+def in_parts(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searcher: Searcher,
+             start: tuple[Vocabulary, MarkovModel, str] | None = None,
+             log: Callable[[str], None] | None = None) -> tuple[Result, tuple[Program, ...]]:
+    """`searched` (a search that found nothing) completed in parts when it can be
+    (`search.parts`: each part's search covers a tenth of the budget, all of them together
+    at most the budget again), with the parts. The program's description length and rank are those of its cheapest spelling
+    under the chain of the whole pairs (or, where that chain rules out an argument a part
+    uses, under the same model with uniform arguments)."""
+    if searched.found or settings.parts < 2:
+        return searched, ()
+    start = start or model_for(settings.library)
+    t0 = time.perf_counter()
+    got, judged = learn_in_parts(pairs, lambda p: chain_for(p, settings, start)[0], searcher,
+                                 PartsSettings(max_parts=settings.parts, budget=max(1, settings.budget // 10),
+                                               allowance=settings.budget),
+                                 log=log)
+    searched = dataclasses.replace(searched, programs=searched.programs + judged,
+                                   seconds=searched.seconds + time.perf_counter() - t0)
+    if got is None:
+        return searched, ()
+    for chain in (chain_for(pairs, settings, start)[0],
+                  chain_for(pairs, dataclasses.replace(settings, args="uniform", fixate=None), start)[0]):
+        spelt = chain.cheapest(got.program.ops, got.program.args)
+        if spelt is not None:
+            break
+    if spelt is None:  # broken syntax cannot come out of joined parts; kept as a guard
+        return searched, ()
+    nats, portions = spelt
+    bins = chain.program_bins(portions)
+    rank = int(chain.count_table(budget=2**62, max_bins=bins)[bins - 1]) + 1 if bins > 0 else 1
+    return dataclasses.replace(searched, found=True, program=got.program, text=text_of(chain, portions),
+                               dl_nats=nats, dl_bins=bins, rank=rank), got.parts
+
+
 def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searcher: Searcher | None = None,
-          progress: Callable[[int], None] | None = None, asked: Sequence[Program] = ()) -> Learned:
+          progress: Callable[[int], None] | None = None, asked: Sequence[Program] = (),
+          log: Callable[[str], None] | None = None) -> Learned:
     """Learn a program for `pairs` (at least one), and judge the rivals found beside it.
-    `asked`: the programs an earlier question was about, when `pairs` holds its answer."""
+    `asked`: the programs an earlier question was about, when `pairs` holds its answer.
+    When nothing fits, the program is learned in parts (`in_parts`); rivals are then not
+    searched (the whole program ranks past any rival budget)."""
     if not pairs:
         raise ValueError("learning needs at least one example pair")
-    chain, name = chain_for(pairs, settings)
+    start = model_for(settings.library)
+    chain, name = chain_for(pairs, settings, start)
     if searcher is None:
         from search.explore import Explorer
 
         searcher = Explorer(width=1)
     task = Task.from_pairs(pairs)
     first = settle(searcher.search(chain, task, settings.budget, progress), chain, pairs, asked)
-    result = with_rivals(first, chain, task, settings, searcher, progress, [a for a, _ in pairs])
+    first, parts = in_parts(first, pairs, settings, searcher, start, log)
+    result = first if parts else with_rivals(first, chain, task, settings, searcher, progress, [a for a, _ in pairs])
     verdict, scenes = verdict_for(result, pairs, settings)
-    return Learned(result, name, verdict, scenes)
+    return Learned(result, name, verdict, scenes, parts)

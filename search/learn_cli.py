@@ -33,7 +33,7 @@ def _settings(a: argparse.Namespace):
         if bad:
             raise VCCError(f"--fixate {a.fixate}: each value must be one of {', '.join(FIXATE_TARGETS)}")
     return LearnSettings(budget=a.budget, args=a.args, fixate=fixate, library=a.library,
-                         rival_budget=a.rival_budget, fresh_scenes=a.fresh_scenes, seed=a.seed)
+                         rival_budget=a.rival_budget, fresh_scenes=a.fresh_scenes, seed=a.seed, parts=a.parts)
 
 
 def _letter(k: int) -> str:
@@ -51,11 +51,13 @@ def concept_record(learned, examples: list[tuple[str, object, object]], files: l
         "program": r.program.text(), "as_searched": r.text, "description_length": round(r.dl_nats, 4),
         "pairs_right": len(examples), "pairs": len(examples), "ambiguous": learned.ambiguous,
         "rivals": rivals, "fresh_scenes": learned.verdict.scenes if learned.verdict else 0,
+        "parts": [p.text() for p in learned.parts],
         "library": learned.library, "examples": files,
         "search": {"rank": r.rank, "programs_judged": r.programs, "seconds": round(r.seconds, 3),
                    "compile_seconds": round(r.compile_seconds, 3), "budget": r.budget},
         "settings": {"budget": settings.budget, "args": settings.args, "fixate": settings.fixate,
-                     "library": settings.library, "rival_budget": settings.rival_budget, "seed": settings.seed},
+                     "library": settings.library, "rival_budget": settings.rival_budget, "seed": settings.seed,
+                     "parts": settings.parts},
     }
 
 
@@ -118,7 +120,8 @@ def cmd_learn(a: argparse.Namespace) -> int:
     asked = asked_before(Path(a.out), files)
     if asked:
         print(f"the pairs answer the question in {a.out}: its {len(asked)} programs are weighed too")
-    learned = learn(pairs, settings, searcher, progress=lambda n: bar.update(n), asked=asked)
+    learned = learn(pairs, settings, searcher, progress=lambda n: bar.update(n), asked=asked,
+                    log=None if a.quiet else (lambda line: (bar.clear(), print(line))))
     bar.close()
     r = learned.result
     if not r.found:
@@ -187,6 +190,10 @@ def _report(learned, record: dict, out: Path) -> None:
     print(f"  {r.program.text()}")
     if r.text != r.program.text():
         print(f"  as searched: {r.text}")
+    if learned.parts:
+        print(f"learned in {len(learned.parts)} parts (nothing whole within the budget; rivals not searched):")
+        for k, part in enumerate(learned.parts, 1):
+            print(f"  part {k}: {part.text()}")
     print(f"explains {record['pairs_right']} of {record['pairs']} pairs")
     if learned.ambiguous:
         print(f"AMBIGUOUS: {len(record['rivals'])} other program(s) explain every pair but act otherwise on new scenes:")
@@ -245,6 +252,9 @@ def add_commands(sub) -> None:
     p.add_argument("--rival-budget", type=runtime.count(0, 10**10), default=2_000_000,
                    help="a second pass looks for rivals among the programs ranked up to this many past the first "
                         "fit (default 2000000; 0: none)")
+    p.add_argument("--parts", type=runtime.count(1, 5), default=3,
+                   help="when no program fits within the budget, learn one in up to this many parts, each bringing "
+                        "the examples closer to their outputs (default 3; 1: never)")
     p.add_argument("--fresh-scenes", type=runtime.count(1, 10**5), default=100,
                    help="scenes the rivals are compared on (default 100)")
     p.add_argument("--seed", type=runtime.count(0), default=0, help="seed of the fresh scenes (default 0)")

@@ -61,9 +61,13 @@ class ScalarBackend:
                     break
             children.append(machines)
             if not failed[i] and request.may_end[i]:
-                solved[i] = all(scenes_match(m.output_scene(), output, self.cfg.tau)
-                                for m, (_, output) in zip(machines, task.pairs, strict=True))
+                solved[i] = self.solves(machines, task)
         return Reply(children, failed, solved)
+
+    def solves(self, machines: list[RefMachine], task: Task) -> bool:
+        """Whether a complete program's machines (one per example) explain every example."""
+        return all(scenes_match(m.output_scene(), output, self.cfg.tau)
+                   for m, (_, output) in zip(machines, task.pairs, strict=True))
 
 
 class ScalarExplorer(Searcher):

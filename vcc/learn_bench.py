@@ -4,7 +4,9 @@ with the shipped library against from scratch, and the questions asked back.
 Rows, one JSON line each in `RUN/results.jsonl` (written as soon as known; a rerun
 resumes and refuses a folder made with other settings, programs or examples):
 - `learn`: each concept x examples (10 and 3 by default) x start (library, uniform),
-  predicted arguments, the budget: found, and right on all 50 test pairs;
+  predicted arguments, the budget: found, and right on all 50 test pairs; what no whole
+  program within the budget fits is then learned in parts from the same start, as
+  `vcc learn` does (`parts`: how many, 0 when whole);
 - `ask`: each concept from 2 examples with the library, as `vcc learn` runs: whether
   the first program found is right, whether the pairs were reported ambiguous, and,
   when they were, whether one answered query settles it (the query's input with the
@@ -29,8 +31,9 @@ from vccjax.records import append_line
 
 STARTS = ("library", "uniform")
 # 2: the answered question is learned again with the programs it was about, and fresh
-# scenes may hold one object more than the examples (a run of another protocol is refused)
-PROTOCOL = 2
+# scenes may hold one object more than the examples; 3: what no whole program fits is
+# learned in parts (`search.parts`) (a run of another protocol is refused)
+PROTOCOL = 3
 # What every results line must hold (the key of `_key`, and whether it was found).
 RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 
@@ -64,7 +67,7 @@ def _open_run(folder: Path, meta: dict) -> list[dict]:
 def cmd_bench_learn(a: argparse.Namespace) -> int:
     from search.explore import Explorer
     from search.induce import generalization
-    from search.learn import LearnSettings, chain_for, learn, model_for
+    from search.learn import LearnSettings, chain_for, in_parts, learn, model_for
     from search.task import Task
     from vccjax.machine.config import DEFAULT_CONFIG
     from vccjax.world.concepts import read_programs
@@ -113,18 +116,22 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
             jobs = [(chain_for(ds.pairs(c, "train")[:k], settings, starts[start])[0],
                      Task.from_pairs(ds.pairs(c, "train")[:k])) for c in todo]
 
-            def finished(j: int, r, todo=todo, k=k, start=start) -> None:
-                c = todo[j]
+            def record(c: str, r, parts: tuple, k=k, start=start) -> None:
                 right = generalization(r.program, ds.pairs(c, "test"), tau) if r.found else 0
                 write({"kind": "learn", "concept": c, "examples": k, "start": start, "found": r.found,
                        "right": bool(r.found and right == len(ds.pairs(c, "test"))), "test_right": right,
-                       "program": r.program.text() if r.found else None, "rank": r.rank,
+                       "program": r.program.text() if r.found else None, "rank": r.rank, "parts": len(parts),
                        "programs": r.programs, "seconds": round(r.seconds, 3)})
                 if not a.quiet:
                     print(f"  {c}: {'found' if r.found else 'not found'}"
+                          + (f" in {len(parts)} parts" if parts else "")
                           + (f", {right}/{len(ds.pairs(c, 'test'))} test pairs" if r.found else ""))
 
-            explorer.search_many(jobs, a.budget, finished)
+            unfound = []
+            explorer.search_many(jobs, a.budget, lambda j, r, todo=todo: (
+                record(todo[j], r, ()) if r.found else unfound.append((todo[j], r))))
+            for c, r in unfound:  # one at a time: each part's search is a search of its own
+                record(c, *in_parts(r, ds.pairs(c, "train")[:k], settings, explorer, starts[start]))
     # asking back: two examples, the library, rivals on (as vcc learn runs)
     k = a.ask_examples
     for c in names:
@@ -169,7 +176,9 @@ def summarise(records: list[dict], names: list[str], examples: list[int], ask: i
         for s in STARTS:
             rows = [r for r in records if r["kind"] == "learn" and r["examples"] == k and r["start"] == s]
             table[f"{s}, {k} examples"] = {"concepts": len(rows), "found": sum(r["found"] for r in rows),
-                                           "right": sum(r["right"] for r in rows)}
+                                           "right": sum(r["right"] for r in rows),
+                                           "in_parts": sum(r["found"] and r.get("parts", 0) > 0 for r in rows),
+                                           "right_in_parts": sum(r["right"] and r.get("parts", 0) > 0 for r in rows)}
     asks = [r for r in records if r["kind"] == "ask" and r["examples"] == ask]
     wrong = [r for r in asks if r["found"] and not r["right"]]
     right = [r for r in asks if r["right"]]
@@ -220,9 +229,10 @@ def _write_summary(a: argparse.Namespace, summary: dict, timing: dict | None, ru
 
     report = {**stamp(a, "learn"), "benchmark": "learn", "run": str(run), **summary, "timing": timing}
     files.write_json(a.out, report)
-    print(f"{'':28}{'found':>8}{'right':>8}   (of {summary['concepts']} new concepts; right: all 50 test pairs)")
+    print(f"{'':28}{'found':>8}{'right':>8}{'in parts':>10}   (of {summary['concepts']} new concepts; right: all 50 "
+          "test pairs; in parts: of the right, learned in parts)")
     for label, row in summary["learn"].items():
-        print(f"{label:28}{row['found']:>8}{row['right']:>8}")
+        print(f"{label:28}{row['found']:>8}{row['right']:>8}{row['right_in_parts']:>10}")
     s = summary["ask"]
     print(f"from {s['examples']} examples: first program right {s['first_right']}, wrong {s['first_wrong']}; "
           f"of the wrong, reported ambiguous {s['wrong_reported_ambiguous']}, settled by one answered query "

@@ -232,9 +232,10 @@ def learn_section(results: list[tuple[str, dict]]) -> list[str]:
         return []
     name, d = runs[-1]
     lines = [f"## New concepts learned from their pairs ({d['concepts']}, none among the 546)", "", _stamp(name, d), "",
-             "| start, examples | found | right on all test pairs |", "|---|---|---|"]
+             "| start, examples | found | right on all test pairs | of them learned in parts |", "|---|---|---|---|"]
     for label, row in d["learn"].items():
-        lines.append(f"| {label} | {row['found']} of {row['concepts']} | {row['right']} of {row['concepts']} |")
+        lines.append(f"| {label} | {row['found']} of {row['concepts']} | {row['right']} of {row['concepts']} | "
+                     f"{row.get('right_in_parts', 'not counted')} |")
     a = d["ask"]
     lines += ["", f"Asking back from {a['examples']} examples: first program right {a['first_right']}, wrong "
               f"{a['first_wrong']}; of the wrong, reported ambiguous {a['wrong_reported_ambiguous']}, settled by one "

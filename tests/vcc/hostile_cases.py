@@ -326,6 +326,8 @@ case("learn-budget-zero", "learn", EXOK, *_flags(LE, budget="0"), setup="example
 case("learn-budget-negative", "learn", EXOK, *_flags(LE, budget="-1"), setup="examples", writes=W_OUT)
 case("learn-budget-nan", "learn", EXOK, *_flags(LE, budget="nan"), setup="examples", writes=W_OUT)
 case("learn-rival-negative", "learn", EXOK, *_flags(LE, rival_budget="-1"), setup="examples", writes=W_OUT)
+case("learn-parts-zero", "learn", EXOK, *_flags(LE, parts="0"), setup="examples", writes=W_OUT)
+case("learn-parts-many", "learn", EXOK, *_flags(LE, parts="6"), setup="examples", writes=W_OUT)
 case("learn-fresh-zero", "learn", EXOK, *_flags(LE, fresh_scenes="0"), setup="examples", writes=W_OUT)
 case("learn-fresh-negative", "learn", EXOK, *_flags(LE, fresh_scenes="-10"), setup="examples", writes=W_OUT)
 case("learn-seed-negative", "learn", EXOK, *_flags(LE, seed="-1"), setup="examples", writes=W_OUT, slow=True)

@@ -213,14 +213,14 @@ def test_the_report_tabulates_the_camera_sweep_of_the_latest_file():
 def test_the_report_gives_the_learning_benchmark_and_vcc_learns_wall_time():
     from vcc.report import learn_section
 
-    learn = {"library, 10 examples": {"concepts": 4, "found": 3, "right": 2}}
+    learn = {"library, 10 examples": {"concepts": 4, "found": 3, "right": 2, "right_in_parts": 1}}
     ask = {"examples": 2, "first_right": 1, "first_wrong": 2, "wrong_reported_ambiguous": 2,
            "wrong_settled_by_one_query": 1, "right_reported_ambiguous": 0}
     timing = {"concept": "c", "instructions": 4, "pairs": 5, "cold_seconds": 50.5, "warm_seconds": 9.25, "cores": 2}
     old = {"benchmark": "learn", "date": "2031-01-01", "concepts": 4, "learn": {}, "ask": ask, "timing": None}
     new = {"benchmark": "learn", "date": "2031-02-01", "concepts": 4, "learn": learn, "ask": ask, "timing": timing}
     lines = learn_section([("old.json", old), ("new.json", new)])
-    assert "| library, 10 examples | 3 of 4 | 2 of 4 |" in lines
+    assert "| library, 10 examples | 3 of 4 | 2 of 4 | 1 |" in lines
     text = "\n".join(lines)
     assert "settled by one answered query 1" in text and "cold 50.5 s, warm 9.25 s on 2 cores" in text
     assert "`new.json`" in text and learn_section([]) == []

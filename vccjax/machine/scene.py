@@ -132,11 +132,9 @@ def box_inside(x: int, y: int, w: int, cfg: VCCConfig) -> bool:
     return 2 * x - w >= 0 and 2 * x + w <= u2 and 2 * y - w >= 0 and 2 * y + w <= u2
 
 
-def scenes_match(a: Scene, b: Scene, tau: float) -> bool:
-    """docs/vcc.md section 7: same object count, matched one to one by shape, color and center within tau."""
-    if len(a.objects) != len(b.objects):
-        return False
-    n = len(a.objects)
+def matching_size(a: Scene, b: Scene, tau: float) -> int:
+    """How many objects of `a` can be paired one to one with objects of `b` of the same
+    shape and color and a center within tau (a maximum bipartite matching)."""
     ok = [
         [
             oa.shape == ob.shape
@@ -146,10 +144,10 @@ def scenes_match(a: Scene, b: Scene, tau: float) -> bool:
         ]
         for oa in a.objects
     ]
-    match_b = [-1] * n
+    match_b = [-1] * len(b.objects)
 
     def augment(i: int, seen: list[bool]) -> bool:
-        for j in range(n):
+        for j in range(len(b.objects)):
             if ok[i][j] and not seen[j]:
                 seen[j] = True
                 if match_b[j] < 0 or augment(match_b[j], seen):
@@ -157,4 +155,15 @@ def scenes_match(a: Scene, b: Scene, tau: float) -> bool:
                     return True
         return False
 
-    return all(augment(i, [False] * n) for i in range(n))
+    return sum(augment(i, [False] * len(b.objects)) for i in range(len(a.objects)))
+
+
+def scenes_match(a: Scene, b: Scene, tau: float) -> bool:
+    """docs/vcc.md section 7: same object count, matched one to one by shape, color and center within tau."""
+    return len(a.objects) == len(b.objects) and matching_size(a, b, tau) == len(a.objects)
+
+
+def scene_distance(a: Scene, b: Scene, tau: float) -> int:
+    """Objects of either scene left unpaired by `matching_size`: 0 exactly when the
+    scenes match; each object a program must still change, remove or add counts."""
+    return len(a.objects) + len(b.objects) - 2 * matching_size(a, b, tau)

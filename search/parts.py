@@ -1,0 +1,174 @@
+"""Learning in parts: a concept whose program lies past the budget, learned as a first
+part that brings every example closer to its output, then the rest from there.
+
+A user's concept often does one thing to one object and another to a second ("recolor
+the top object red and the bottom one blue"). The whole program can rank far past the
+budget even when each half is among the first thousand programs, because the model
+learned on the 546 rarely saw the join. When the search finds nothing, `learn_in_parts`:
+
+1. searches for *first parts*: programs under which every example's scene gets strictly
+   closer to its output (`vccjax.machine.scene.scene_distance`: objects still unpaired
+   with an output object drop; no example gets farther or loses an object its output
+   keeps: `gains`), one per distinct effect on the examples, the most progress first;
+2. runs each first part on the inputs and searches for the rest on the pairs (what the
+   first part made, the output), recursively up to `max_parts` parts;
+3. joins the parts (the rest's `scene_parse` dropped, a `reset_attn` between them where
+   the join needs it) and keeps the join only if the reference machine runs it right on
+   every given pair: a program learned in parts is checked like any other.
+
+The first parts are judged on the host by the scalar reference (`ScalarBackend` with
+another judge); the rest is an ordinary search on the caller's searcher. Each search
+covers a tenth of `vcc learn`'s budget, and all of them together at most the budget
+again, so a concept that cannot be learned costs at most twice the plain search.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+
+from search.ambiguity import outcomes
+from search.chain import Chain
+from search.dfs import Alternatives
+from search.explore import Searcher
+from search.result import program_of
+from search.scalar import ScalarBackend
+from search.task import Task
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.instructions import OP
+from vccjax.machine.program import Program
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import Scene, scene_distance, scenes_match
+
+
+@dataclasses.dataclass(frozen=True)
+class PartsSettings:
+    max_parts: int = 3  # parts a program may be learned in (1: never in parts)
+    budget: int = 50_000  # each part's search: its budget (the most probable programs it covers)
+    allowance: int = 500_000  # the parts' searches' budgets added up, at most
+    tries: int = 4  # first parts tried, one per distinct effect on the examples
+    candidates: int = 16  # first parts kept by their search, of which the `tries` of most progress
+    margin_nats: float = 8.0  # first parts at most this much less probable than the cheapest
+
+
+@dataclasses.dataclass(frozen=True)
+class InParts:
+    """A program learned in parts, and the parts (each as its own program)."""
+
+    program: Program
+    parts: tuple[Program, ...]
+
+
+class ProgressBackend(ScalarBackend):
+    """The scalar search whose judge accepts a program that brings the examples closer
+    to their outputs (fewer objects left unpaired): no example farther, some closer. (Not
+    every example closer: where the first part's change is already made, as a top object
+    already red, it rightly does nothing.)"""
+
+    def solves(self, machines: list[RefMachine], task: Task) -> bool:
+        return gains([m.output_scene() for m in machines], task.pairs, self.cfg.tau) is not None
+
+
+def gains(made: Sequence[Scene | None], pairs: Sequence[tuple[Scene, Scene]], tau: float) -> list[int] | None:
+    """Per pair, how much closer `made` is to the output than the input was, or None
+    unless the scenes made are progress: none failed, none farther, some closer, and
+    none with fewer objects than its output (no instruction adds an object back, so a
+    removal there could never be made good: removing a misplaced object is not progress)."""
+    if any(m is None for m in made):
+        return None
+    if any(len(m.objects) < len(b.objects) for m, (_, b) in zip(made, pairs, strict=True)):
+        return None
+    out = [scene_distance(a, b, tau) - scene_distance(m, b, tau) for m, (a, b) in zip(made, pairs, strict=True)]
+    return out if min(out) >= 0 and sum(out) > 0 else None
+
+
+def progress(program: Program, pairs: Sequence[tuple[Scene, Scene]], cfg: VCCConfig = DEFAULT_CONFIG) -> int:
+    """Objects brought right over all pairs (`gains` summed; 0 when not progress)."""
+    made = gains(outcomes(program, [a for a, _ in pairs], cfg), pairs, cfg.tau)
+    return 0 if made is None else sum(made)
+
+
+def first_parts(chain: Chain, pairs: Sequence[tuple[Scene, Scene]], settings: PartsSettings,
+                cfg: VCCConfig = DEFAULT_CONFIG) -> tuple[list[Program], int]:
+    """(first parts, most progress first then most probable; complete programs judged):
+    programs that bring the pairs closer to their outputs (`ProgressBackend`), one per distinct effect on the
+    pairs (two that make the same scenes would leave the same rest to learn)."""
+    inputs = [a for a, _ in pairs]
+
+    def effect(path) -> tuple:
+        made = outcomes(program_of(chain, [int(x) for x in path if x >= 0]), inputs, cfg)
+        return tuple((None if m is None else (m.objects, m.pointer)) for m in made)
+
+    searcher = Searcher(ProgressBackend(cfg), width=1)
+    alternatives = Alternatives(int(math.ceil(settings.margin_nats / chain.delta)), settings.candidates,
+                                settings.budget, effect)
+    r = searcher.search(chain, Task.from_pairs(pairs, cfg), settings.budget, alternatives=alternatives)
+    if not r.found:
+        return [], r.programs
+    found = [r.program] + [a.program for a in r.alternatives]
+    order = sorted(range(len(found)), key=lambda i: (-progress(found[i], pairs, cfg), i))
+    return [found[i] for i in order][: settings.tries], r.programs
+
+
+def joins(first: Program, rest: Program) -> list[Program]:
+    """The two ways to run `rest` after `first`: straight on, and after `reset_attn` (the
+    rest was learned from a fresh machine, with nothing attended)."""
+    tail_ops, tail_args = rest.ops[1:], rest.args[1:]  # every program starts with scene_parse
+    reset = OP["reset_attn"]
+    return [Program(first.ops + tail_ops, first.args + tail_args),
+            Program(first.ops + (reset,) + tail_ops, first.args + (0,) + tail_args)]
+
+
+def fits(program: Program, pairs: Sequence[tuple[Scene, Scene]], cfg: VCCConfig = DEFAULT_CONFIG) -> bool:
+    made = outcomes(program, [a for a, _ in pairs], cfg)
+    return all(m is not None and scenes_match(m, b, cfg.tau) for m, (_, b) in zip(made, pairs, strict=True))
+
+
+class _Allowance:
+    """What the parts' searches may still cover, shared down the recursion."""
+
+    def __init__(self, left: int):
+        self.left = left
+
+    def take(self, budget: int) -> bool:
+        if self.left < budget:
+            return False
+        self.left -= budget
+        return True
+
+
+def learn_in_parts(pairs: Sequence[tuple[Scene, Scene]], chain_of: Callable[[Sequence[tuple[Scene, Scene]]], Chain],
+                   searcher: Searcher, settings: PartsSettings, cfg: VCCConfig = DEFAULT_CONFIG,
+                   log: Callable[[str], None] | None = None,
+                   allowance: _Allowance | None = None) -> tuple[InParts | None, int]:
+    """(a program for `pairs` in at most `settings.max_parts` parts or None, complete
+    programs judged). `chain_of` gives the search's chain for a set of pairs (its
+    argument beliefs come from them). Every search, first parts or rest, has
+    `settings.budget`; they stop when `settings.allowance` is spent."""
+    allowance = allowance or _Allowance(settings.allowance)
+    if settings.max_parts < 2 or not allowance.take(settings.budget):
+        return None, 0
+    firsts, judged = first_parts(chain_of(pairs), pairs, settings, cfg)
+    for first in firsts:
+        if not allowance.take(settings.budget):
+            break
+        made = outcomes(first, [a for a, _ in pairs], cfg)
+        rest_pairs = [(m, b) for m, (_, b) in zip(made, pairs, strict=True)]
+        if log:
+            log(f"first part {first.text()}: the rest from what it makes")
+        rest = searcher.search(chain_of(rest_pairs), Task.from_pairs(rest_pairs, cfg), settings.budget)
+        judged += rest.programs
+        tails: list[tuple[Program, tuple[Program, ...]]] = [(rest.program, (rest.program,))] if rest.found else []
+        if not rest.found and settings.max_parts > 2:
+            deeper, n = learn_in_parts(rest_pairs, chain_of, searcher,
+                                       dataclasses.replace(settings, max_parts=settings.max_parts - 1), cfg, log,
+                                       allowance)
+            judged += n
+            if deeper is not None:
+                tails.append((deeper.program, deeper.parts))
+        for tail, tail_parts in tails:
+            for joined in joins(first, tail):
+                if fits(joined, pairs, cfg):
+                    return InParts(joined, (first,) + tail_parts), judged
+    return None, judged
