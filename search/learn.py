@@ -212,33 +212,45 @@ def in_parts(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: L
              log: Callable[[str], None] | None = None) -> tuple[Result, tuple[Program, ...]]:
     """`searched` (a search that found nothing) completed in parts when it can be
     (`search.parts`: each part's search covers a tenth of the budget, all of them together
-    at most the budget again), with the parts. The program's description length and rank are those of its cheapest spelling
-    under the chain of the whole pairs (or, where that chain rules out an argument a part
-    uses, under the same model with uniform arguments)."""
+    at most the budget again), with the parts. The program's description length and rank
+    are those of its cheapest spelling under the chain of the whole pairs (or, where that
+    chain rules out an argument a part uses, under the same model with uniform arguments). With a rival budget, the other
+    joins that fit every pair come back as the result's alternatives (`search.parts`)."""
     if searched.found or settings.parts < 2:
         return searched, ()
     start = start or model_for(settings.library)
     t0 = time.perf_counter()
     got, judged = learn_in_parts(pairs, lambda p: chain_for(p, settings, start)[0], searcher,
                                  PartsSettings(max_parts=settings.parts, budget=max(1, settings.budget // 10),
-                                               allowance=settings.budget),
+                                               allowance=settings.budget,
+                                               rivals=settings.max_rivals - 1 if settings.rival_budget else 0),
                                  log=log)
     searched = dataclasses.replace(searched, programs=searched.programs + judged,
                                    seconds=searched.seconds + time.perf_counter() - t0)
     if got is None:
         return searched, ()
-    for chain in (chain_for(pairs, settings, start)[0],
-                  chain_for(pairs, dataclasses.replace(settings, args="uniform", fixate=None), start)[0]):
-        spelt = chain.cheapest(got.program.ops, got.program.args)
-        if spelt is not None:
-            break
-    if spelt is None:  # broken syntax cannot come out of joined parts; kept as a guard
+    chain, nats, portions = _spelt(got.program, pairs, settings, start)
+    if chain is None:  # broken syntax cannot come out of joined parts; kept as a guard
         return searched, ()
-    nats, portions = spelt
     bins = chain.program_bins(portions)
     rank = int(chain.count_table(budget=2**62, max_bins=bins)[bins - 1]) + 1 if bins > 0 else 1
+    rivals = tuple(Alternative(p, text_of(c, z), n) for p in got.rivals
+                   for c, n, z in [_spelt(p, pairs, settings, start)] if c is not None)
     return dataclasses.replace(searched, found=True, program=got.program, text=text_of(chain, portions),
-                               dl_nats=nats, dl_bins=bins, rank=rank), got.parts
+                               dl_nats=nats, dl_bins=bins, rank=rank, alternatives=rivals), got.parts
+
+
+def _spelt(program: Program, pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings,
+           start: tuple[Vocabulary, MarkovModel, str]) -> tuple[Chain | None, float, list[int]]:
+    """(chain, nats, portions) of the program's cheapest spelling under the pairs' chain,
+    or under the same model with uniform arguments where that chain rules out an argument
+    the program uses; (None, inf, []) where neither can spell it."""
+    for chain in (chain_for(pairs, settings, start)[0],
+                  chain_for(pairs, dataclasses.replace(settings, args="uniform", fixate=None), start)[0]):
+        spelt = chain.cheapest(program.ops, program.args)
+        if spelt is not None:
+            return chain, spelt[0], spelt[1]
+    return None, math.inf, []
 
 
 def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searcher: Searcher | None = None,
@@ -246,8 +258,9 @@ def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searche
           log: Callable[[str], None] | None = None) -> Learned:
     """Learn a program for `pairs` (at least one), and judge the rivals found beside it.
     `asked`: the programs an earlier question was about, when `pairs` holds its answer.
-    When nothing fits, the program is learned in parts (`in_parts`); rivals are then not
-    searched (the whole program ranks past any rival budget)."""
+    When nothing fits, the program is learned in parts (`in_parts`); its rivals are then
+    the other joins of parts that fit every pair (the rival pass would start at the
+    program's rank, past any rival budget)."""
     if not pairs:
         raise ValueError("learning needs at least one example pair")
     start = model_for(settings.library)

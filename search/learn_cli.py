@@ -202,7 +202,7 @@ def _report(learned, record: dict, out: Path) -> None:
                   f"{record['fresh_scenes']} fresh scenes)")
         print(f"question: {out / 'query.png'} (and query.json): add its input with the output you mean as a pair, "
               "and learn again")
-    else:
+    elif not learned.parts:  # learned in parts: no rivals were searched (said above)
         print(f"not ambiguous: the programs found beside it act alike on {record['fresh_scenes']} fresh scenes")
     print(f"wrote {out / 'concept.json'} and {out / 'trace.png'}")
 

@@ -35,6 +35,7 @@ from search.explore import Searcher
 from search.result import program_of
 from search.scalar import ScalarBackend
 from search.task import Task
+from vccjax.errors import SceneError
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.instructions import OP
 from vccjax.machine.program import Program
@@ -49,7 +50,8 @@ class PartsSettings:
     allowance: int = 500_000  # the parts' searches' budgets added up, at most
     tries: int = 4  # first parts tried, one per distinct effect on the examples
     candidates: int = 16  # first parts kept by their search, of which the `tries` of most progress
-    margin_nats: float = 8.0  # first parts at most this much less probable than the cheapest
+    margin_nats: float = 8.0  # first parts (and rests' rivals) at most this much less probable than the cheapest
+    rivals: int = 0  # other fitting joins to keep, for the question back (0: stop at the first fit)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -58,6 +60,7 @@ class InParts:
 
     program: Program
     parts: tuple[Program, ...]
+    rivals: tuple[Program, ...] = ()  # other joins that fit every pair (`PartsSettings.rivals`)
 
 
 class ProgressBackend(ScalarBackend):
@@ -145,30 +148,51 @@ def learn_in_parts(pairs: Sequence[tuple[Scene, Scene]], chain_of: Callable[[Seq
     """(a program for `pairs` in at most `settings.max_parts` parts or None, complete
     programs judged). `chain_of` gives the search's chain for a set of pairs (its
     argument beliefs come from them). Every search, first parts or rest, has
-    `settings.budget`; they stop when `settings.allowance` is spent."""
+    `settings.budget`; they stop when `settings.allowance` is spent.
+
+    With `settings.rivals`, the search goes on past the first fit: the rests are searched
+    with their own rivals, every first part is tried, and up to `rivals` other joins that
+    fit every pair are kept, for the question back (few pairs fit many joins)."""
     allowance = allowance or _Allowance(settings.allowance)
     if settings.max_parts < 2 or not allowance.take(settings.budget):
         return None, 0
     firsts, judged = first_parts(chain_of(pairs), pairs, settings, cfg)
+    best: InParts | None = None
+    others: list[Program] = []
     for first in firsts:
-        if not allowance.take(settings.budget):
+        if (best is not None and (len(others) >= settings.rivals)) or not allowance.take(settings.budget):
             break
         made = outcomes(first, [a for a, _ in pairs], cfg)
         rest_pairs = [(m, b) for m, (_, b) in zip(made, pairs, strict=True)]
+        try:
+            task = Task.from_pairs(rest_pairs, cfg)
+        except SceneError:  # a scene the machine made that its loader refuses: not a start to learn from
+            continue
         if log:
             log(f"first part {first.text()}: the rest from what it makes")
-        rest = searcher.search(chain_of(rest_pairs), Task.from_pairs(rest_pairs, cfg), settings.budget)
+        chain = chain_of(rest_pairs)
+        alternatives = (Alternatives(int(math.ceil(settings.margin_nats / chain.delta)), settings.rivals,
+                                     settings.budget) if settings.rivals else None)
+        rest = searcher.search(chain, task, settings.budget, alternatives=alternatives)
         judged += rest.programs
-        tails: list[tuple[Program, tuple[Program, ...]]] = [(rest.program, (rest.program,))] if rest.found else []
-        if not rest.found and settings.max_parts > 2:
+        tails: list[tuple[Program, tuple[Program, ...]]] = []
+        if rest.found:
+            tails = [(p, (p,)) for p in [rest.program] + [a.program for a in rest.alternatives]]
+        elif settings.max_parts > 2:
             deeper, n = learn_in_parts(rest_pairs, chain_of, searcher,
                                        dataclasses.replace(settings, max_parts=settings.max_parts - 1), cfg, log,
                                        allowance)
             judged += n
             if deeper is not None:
-                tails.append((deeper.program, deeper.parts))
+                tails = [(deeper.program, deeper.parts)] + [(p, (p,)) for p in deeper.rivals]
         for tail, tail_parts in tails:
-            for joined in joins(first, tail):
-                if fits(joined, pairs, cfg):
-                    return InParts(joined, (first,) + tail_parts), judged
-    return None, judged
+            joined = next((j for j in joins(first, tail) if fits(j, pairs, cfg)), None)
+            if joined is None or (best is not None and (joined == best.program or joined in others)):
+                continue
+            if best is None:
+                best = InParts(joined, (first,) + tail_parts)
+            elif len(others) < settings.rivals:
+                others.append(joined)
+    if best is None:
+        return None, judged
+    return dataclasses.replace(best, rivals=tuple(others)), judged

@@ -128,3 +128,21 @@ def test_vcc_learn_reports_the_parts_and_writes_them(two_part_pairs, tmp_path, c
     assert main(["learn", str(folder), "--out", str(tmp_path / "none"), "--engine", "reference", "--budget",
                  "20000", "--parts", "1", "--quiet"]) == 2  # in one part only: nothing fits
     assert not (tmp_path / "none").exists()
+
+
+def test_from_few_pairs_the_other_joins_that_fit_come_back_as_rivals(two_part_pairs):
+    """The question back needs the rivals of a program learned in parts: the other joins
+    that fit every pair, each a different program that explains them all."""
+    pairs = two_part_pairs[:2]
+    got = learn(pairs, LearnSettings(budget=200_000, rival_budget=1, fresh_scenes=20), ScalarExplorer(width=1))
+    assert got.found and got.parts
+    rivals = [a.program for a in got.result.alternatives]
+    assert rivals and got.program not in rivals and len(set(rivals)) == len(rivals)
+    for program in rivals:
+        for a, b in pairs:
+            m = RefMachine(a).run(program)
+            assert not m.failed and scenes_match(m.output_scene(), b, TAU)
+    assert got.verdict is not None and got.verdict.programs[0] == 0
+    # two pairs fit joins that part ways on fresh scenes (one recolours "the red object"
+    # blue where another recolours the bottom one): the pairs are reported ambiguous
+    assert got.ambiguous
