@@ -214,8 +214,9 @@ def in_parts(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: L
     (`search.parts`: each part's search covers a tenth of the budget, all of them together
     at most the budget again), with the parts. The program's description length and rank
     are those of its cheapest spelling under the chain of the whole pairs (or, where that
-    chain rules out an argument a part uses, under the same model with uniform arguments). With a rival budget, the other
-    joins that fit every pair come back as the result's alternatives (`search.parts`)."""
+    chain rules out an argument a part uses, under the same model with uniform arguments).
+    With a rival budget, the other joins that fit every pair come back as the result's
+    alternatives."""
     if searched.found or settings.parts < 2:
         return searched, ()
     start = start or model_for(settings.library)

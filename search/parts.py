@@ -95,8 +95,8 @@ def progress(program: Program, pairs: Sequence[tuple[Scene, Scene]], cfg: VCCCon
 def first_parts(chain: Chain, pairs: Sequence[tuple[Scene, Scene]], settings: PartsSettings,
                 cfg: VCCConfig = DEFAULT_CONFIG) -> tuple[list[Program], int]:
     """(first parts, most progress first then most probable; complete programs judged):
-    programs that bring the pairs closer to their outputs (`ProgressBackend`), one per distinct effect on the
-    pairs (two that make the same scenes would leave the same rest to learn)."""
+    programs that bring the pairs closer to their outputs (`ProgressBackend`), one per
+    distinct effect on the pairs (two that make the same scenes leave the same rest)."""
     inputs = [a for a, _ in pairs]
 
     def effect(path) -> tuple:
