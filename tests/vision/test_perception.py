@@ -168,3 +168,31 @@ def test_the_smallest_objects_keep_their_shape_under_blur_noise_and_jpeg(seed):
                  for k, s in enumerate(shapes)))
     got = parse_image(draw(sc, "photo", 256, seed=seed))
     assert scenes_match(got, sc, CFG.tau), (seed, got)
+
+
+@pytest.mark.parametrize("side", ["left", "right", "top", "bottom"])
+def test_a_fringe_of_specks_along_one_edge_leaves_a_square_square(side):
+    """On a speckled table (as the arm's camera sees one) dark specks hugging one edge of
+    a green box join its region as a ragged fringe two pixels thick; the box must not
+    widen the square's placement until a circle overlaps better (it did, one green box in
+    fifty on that table)."""
+    rng = np.random.default_rng(3)
+    img = np.full((384, 384, 3), 200, np.uint8)
+    img[rng.random((384, 384)) < 0.08] = 90  # the table's specks
+    y0, x0, n = 170, 180, 44
+    img[y0:y0 + n, x0:x0 + n] = (26, 200, 46)
+    rows = np.nonzero(rng.random(n) < 0.4)[0] + y0
+    for r in rows:  # specks along one edge, one to three pixels out
+        d = int(rng.integers(1, 4))
+        if side == "left":
+            img[r, x0 - d:x0] = 60
+        elif side == "right":
+            img[r, x0 + n:x0 + n + d] = 60
+        elif side == "top":
+            img[y0 - d:y0, r - y0 + x0] = 60
+        else:
+            img[y0 + n:y0 + n + d, r - y0 + x0] = 60
+    got = parse_image(img)
+    assert [(o.shape, o.color) for o in got.objects] == [("square", "green")]
+    o = got.objects[0]
+    assert abs(o.x - (x0 + n / 2) / 384) < 0.01 and abs(o.y - (y0 + n / 2) / 384) < 0.01

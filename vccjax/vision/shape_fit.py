@@ -25,6 +25,10 @@ STAR_IOU_SLACK = 0.2
 # that leaves two parts each fitting at least SPLIT_PART_FIT, if that gains SPLIT_GAIN.
 SPLIT_BELOW, SPLIT_ASPECT, SPLIT_MIN_PX, SPLIT_PART_FIT, SPLIT_GAIN = 0.75, 1.3, 200, 0.75, 0.1
 
+# A fringe joined to a region (texture specks, a shadowed side face) is at most this
+# thick: FRINGE_PX pixels, or FRINGE_SHARE of the region's side on large regions.
+FRINGE_PX, FRINGE_SHARE = 3, 0.1
+
 Fit = tuple[str, float, float, float]  # shape, centre x, centre y, width (image pixels)
 
 
@@ -60,29 +64,50 @@ def _solidity(region: np.ndarray) -> float:
     return float(region.sum()) / max(cv2.contourArea(hull) + cv2.arcLength(hull, True) / 2, 1.0)
 
 
-def fit_one(region: np.ndarray, x0: int, y0: int) -> tuple[float, Fit]:
+def fit_one(region: np.ndarray, x0: int, y0: int, fringe: bool = True) -> tuple[float, Fit]:
     """(intersection over union, fit) of the best-fitting shape for a region cropped to its
     box at (x0, y0): the ideal rendering that overlaps it best. A region that fills little of its
     convex hull is a star even when blurred or outlined points make another shape overlap
     it better (`STAR_SOLIDITY`); a little-filled one whose overlap with a star is close
-    to the best is one too (a stray pixel at a corner can thin a triangle's fill)."""
+    to the best is one too (a stray pixel at a corner can thin a triangle's fill).
+    `fringe`: also place the shapes by the box of a solid region's body (`_boxes`)."""
     h, w = region.shape
+    solidity = _solidity(region)
     pad = 2
     win = np.zeros((h + 2 * pad, w + 2 * pad), bool)
     win[pad : pad + h, pad : pad + w] = region
     fits: dict[str, tuple[float, Fit]] = {}
-    for shape in SHAPES:
-        for grow in (-0.5, 0.0, 0.5, 1.0):
-            cx, cy, width = box_to_object(shape, pad - grow / 2, pad - grow / 2, w + grow, h + grow)
-            t = _template(shape, cx, cy, width, 0, 0, w + 2 * pad, h + 2 * pad)
-            iou = (t & win).sum() / max((t | win).sum(), 1)
-            if iou > fits.get(shape, (-1.0,))[0]:
-                fits[shape] = (iou, (shape, cx - pad + x0, cy - pad + y0, width))
+    for bx, by, bw, bh in (_boxes(region) if fringe and solidity >= STAR_SOLIDITY[0] else [(0, 0, w, h)]):
+        for shape in SHAPES:
+            for grow in (-0.5, 0.0, 0.5, 1.0):
+                cx, cy, width = box_to_object(shape, pad + bx - grow / 2, pad + by - grow / 2, bw + grow, bh + grow)
+                t = _template(shape, cx, cy, width, 0, 0, w + 2 * pad, h + 2 * pad)
+                iou = (t & win).sum() / max((t | win).sum(), 1)
+                if iou > fits.get(shape, (-1.0,))[0]:
+                    fits[shape] = (iou, (shape, cx - pad + x0, cy - pad + y0, width))
     best = max(fits.values(), key=lambda f: f[0])
-    solidity = _solidity(region)
     if solidity < STAR_SOLIDITY[0] or (solidity < STAR_SOLIDITY[1] and fits["star"][0] >= best[0] - STAR_IOU_SLACK):
         return fits["star"]
     return best
+
+
+def _boxes(region: np.ndarray) -> list[tuple[int, int, int, int]]:
+    """Where to place the ideal shapes (x, y, width, height in the region's crop): its box,
+    and the box of its body without fringes a pixel or two thick (texture specks or a
+    side face in shadow joined to one edge widen the box, and a square placed by a box
+    wider than it is overlaps worse than a circle). The overlap is judged on the whole
+    region either way. Used on solid regions only, and not on the halves of a region
+    being cut in two: a star's points or a half's ragged cut are no fringe."""
+    h, w = region.shape
+    boxes = [(0, 0, w, h)]
+    body = cv2.morphologyEx(region.astype(np.uint8), cv2.MORPH_OPEN, np.ones((5, 5), np.uint8)) > 0
+    if body.any():
+        ys, xs = np.nonzero(_largest(body))
+        inner = (int(xs.min()), int(ys.min()), int(xs.max() - xs.min() + 1), int(ys.max() - ys.min() + 1))
+        cut = (inner[0], inner[1], w - inner[0] - inner[2], h - inner[1] - inner[3])  # left, top, right, bottom
+        if inner != boxes[0] and max(cut) <= max(FRINGE_PX, FRINGE_SHARE * max(w, h)):
+            boxes.append(inner)  # a fringe, not a star's points (the opening cuts those back further)
+    return boxes
 
 
 def fit_shapes(region: np.ndarray, x0: int, y0: int) -> list[Fit]:
@@ -105,7 +130,7 @@ def fit_shapes(region: np.ndarray, x0: int, y0: int) -> list[Fit]:
                 part = _largest(part)
                 py, px = np.nonzero(part)
                 parts.append((part.sum(), fit_one(part[py.min():py.max() + 1, px.min():px.max() + 1],
-                                                  x0 + px.min(), y0 + py.min())))
+                                                  x0 + px.min(), y0 + py.min(), fringe=False)))
             if min(f[0] for _, f in parts) < SPLIT_PART_FIT:
                 continue
             score = sum(n * f[0] for n, f in parts) / sum(n for n, _ in parts)
