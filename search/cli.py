@@ -13,6 +13,12 @@ def cmd_induce(a: argparse.Namespace) -> int:
     from search.induce import Settings, induce, needs_answer, summary
     from vccjax.world.dataset import dataset_for
 
+    if a.workers is not None and a.cluster != "ray":
+        raise ValueError("--workers: only with --cluster ray")
+    if a.cluster == "ray":
+        from search.cluster import ray_module
+
+        ray_module()  # a missing extra fails now, with its message
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations)
     if a.dataset:  # any built dataset: the concepts its manifest holds, their stored programs as answers
@@ -35,10 +41,20 @@ def cmd_induce(a: argparse.Namespace) -> int:
         ds = dataset_for(names, a.seed, a.dataset, progress=not a.quiet)
     for c in names:  # every concept's examples read and checked before the run folder is touched
         ds.arrays(c)
-    from search.explore import Explorer
+    if a.cluster == "ray":  # concepts in chunks of --width to Ray workers (search.cluster)
+        from search.cluster import ClusterSearcher
 
-    run = induce(names, ds.pairs, a.out, settings, explorer=Explorer(width=a.width), progress=not a.quiet,
-                 examples_sha256=ds.sha256, answers=ds.program, start=start)
+        searcher = ClusterSearcher(workers=a.workers, width=a.width)
+    else:
+        from search.explore import Explorer
+
+        searcher = Explorer(width=a.width)
+    try:
+        run = induce(names, ds.pairs, a.out, settings, explorer=searcher, progress=not a.quiet,
+                     examples_sha256=ds.sha256, answers=ds.program, start=start)
+    finally:
+        if a.cluster == "ray":
+            searcher.close()
     s = summary(run, names)
     files.write_json(Path(a.out) / "summary.json", s)
     print(f"{'concepts':<28}{s['concepts']}")
@@ -119,5 +135,10 @@ def add_commands(sub) -> None:
                         "builds these concepts' examples under ~/.cache/vccjax")
     p.add_argument("--width", type=runtime.count(1, 4096), default=32,
                    help="concepts searched in lockstep, their programs stepped in shared batches (default 32)")
+    p.add_argument("--cluster", choices=["none", "ray"], default="none",
+                   help="'ray': search each iteration's concepts on Ray workers, --width concepts a chunk "
+                        "(joins $RAY_ADDRESS, or starts a local cluster; docs/cluster.md)")
+    p.add_argument("--workers", type=runtime.count(1, 4096),
+                   help="Ray workers, one CPU each (default: one per CPU of the cluster)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(fn=cmd_induce)

@@ -266,6 +266,9 @@ case("induce-iterations-negative", "induce", *_flags(IN, iterations="-1"), write
 case("induce-width-zero", "induce", *_flags(IN, width="0"), writes=W_RUN, slow=True)
 case("induce-width-negative", "induce", *_flags(IN, width="-4"), writes=W_RUN, slow=True)
 case("induce-seed-negative", "induce", *_flags(IN, seed="-1"), writes=W_RUN, slow=True)
+case("induce-workers-without-cluster", "induce", *_flags(IN, workers="2"), writes=W_RUN)
+case("induce-cluster-bad", "induce", *_flags(IN, cluster="spark"), writes=W_RUN)
+case("induce-cluster-workers-zero", "induce", *_flags(IN, cluster="ray", workers="0"), writes=W_RUN, slow=True)
 case("induce-concepts-empty", "induce", *_flags(IN, concepts=""), writes=W_RUN)
 case("induce-concepts-commas", "induce", *_flags(IN, concepts=",,"), writes=W_RUN)
 case("induce-concepts-unknown", "induce", *_flags(IN, concepts="bogus"), writes=W_RUN)
@@ -552,6 +555,9 @@ robot("robot-stress-seed-negative", "robot", "stress", *_flags(ST, seed="-1"), w
 # ---- vcc bench search / emulator / reproduce / report / learn ---------------------------------
 BS = {"concepts": "remove_top_obj", "budget": "1", "width": "1", "out": "{tmp}/bs.json"}
 W_BS = ["{tmp}/bs.json"]
+BC = {"concepts": "remove_top_obj", "budget": "1", "width": "2", "out": "{tmp}/bc.json"}
+case("bench-cluster-workers-zero", "bench", "cluster", *_flags(BC, workers="0"), writes=["{tmp}/bc.json"])
+case("bench-cluster-out-dir", "bench", "cluster", *_flags(BC, out="{tmp}/dir.json"), writes=["{tmp}/bc.json"])
 case("bench-search-sample-zero", "bench", "search", *_flags(BS, concepts=None, sample="0"), writes=W_BS)
 # --sample -1 and --concepts "" would search many concepts: the one-concept --dataset stops them
 case("bench-search-sample-negative", "bench", "search", *_flags(BS, concepts=None, sample="-1",
