@@ -210,6 +210,44 @@ def robot_section(folder: Path) -> list[str]:
     return lines + [""]
 
 
+def stress_section(folder: Path) -> list[str]:
+    """Every stress run under `folder` (a summary.json written by `vcc robot stress`):
+    rollouts, non-finite states, and what was not carried out, by cause."""
+    found = []
+    for path in sorted(folder.glob("*/summary.json")) if folder.exists() else []:
+        try:
+            s = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError):
+            continue
+        if isinstance(s, dict) and "non_finite" in s and "rollouts" in s:
+            found.append((path.parent, s))
+    if not found:
+        return []
+    lines = [f"## The arm's stress runs (`{folder}`, `vcc robot stress`)", "",
+             "| folder | rollouts | concepts drawn | rolled out | non-finite states | carried out | failures by cause |",
+             "|---|---|---|---|---|---|---|"]
+    for path, s in found:
+        fails = ", ".join(f"{c} {n}" for c, n in sorted(s["failures"].items(), key=lambda x: -x[1])) or "none"
+        lines.append(f"| `{path}` | {s['rollouts']} | {s['concepts']} | {s['rolled_out']} | {s['non_finite']} | "
+                     f"{s['success']} ({s['success'] / max(1, s['rollouts']):.1%}) | {fails} |")
+    return lines + [""]
+
+
+def cluster_section(results: list[tuple[str, dict]]) -> list[str]:
+    """One process against Ray workers on the same search (`vcc bench cluster`)."""
+    runs = _latest(results, "cluster")
+    if not runs:
+        return []
+    lines = ["## Explore-compress on Ray workers (`vcc bench cluster`)", "",
+             "| file | model | concepts x budget | one process s | workers | workers s | speed-up | same results |",
+             "|---|---|---|---|---|---|---|---|"]
+    for name, d in runs:
+        lines.append(f"| `{name}` | {d['model']} | {len(d['concepts'])} x {d['budget']:,} | {d['single']['seconds']} | "
+                     f"{d['cluster']['workers']} | {d['cluster']['seconds']} | {d['speedup']}x | {d['results_agree']} |")
+    return lines + ["", "Second passes timed (the first compiles). The one process uses both cores, each "
+                    "worker one (docs/cluster.md).", ""] + [f"- {_stamp(name, d)}" for name, d in runs] + [""]
+
+
 def camera_section(results: list[tuple[str, dict]]) -> list[str]:
     """The arm camera's parse against the true tables (`vcc robot perception`), per condition."""
     runs = _latest(results, "robot-perception")
@@ -281,8 +319,10 @@ def render(results_dir: Path, rows: dict[str, dict], stamp: dict, others: Path |
                             (lambda: reproduce_section(rows), runs),
                             (lambda: other_runs_section(others) if others else [], others),
                             (lambda: robot_section(robot) if robot else [], robot),
+                            (lambda: stress_section(robot) if robot else [], robot),
                             (lambda: camera_section(results), results_dir),
-                            (lambda: learn_section(results), results_dir)):
+                            (lambda: learn_section(results), results_dir),
+                            (lambda: cluster_section(results), results_dir)):
         try:
             lines += section()
         except DataFileError:

@@ -198,6 +198,40 @@ def test_the_report_lists_each_arm_suite_with_its_failures_and_parse(tmp_path):
     assert robot_section(tmp_path / "none") == []
 
 
+def test_the_report_lists_each_stress_run_and_skips_suites(tmp_path):
+    """A stress run's summary.json becomes one row (non-finite states, rate, failures by
+    cause, most first); a suite's summary is not a stress run."""
+    from vcc.report import stress_section
+
+    run = tmp_path / "stress"
+    run.mkdir()
+    (run / "summary.json").write_text(json.dumps({
+        "seed": 7, "batches": 2, "rollouts": 64, "rolled_out": 62, "non_finite": 0, "success": 59,
+        "failures": {"misplaced": 1, "parse wrong": 2, "grasp slipped": 2}, "concepts": 40}))
+    (tmp_path / "suite").mkdir()
+    (tmp_path / "suite" / "summary.json").write_text(json.dumps({"source": {}, "parse": {}, "rollouts": 8}))
+    lines = stress_section(tmp_path)
+    rows = [x for x in lines if x.startswith("| `")]
+    assert rows == [f"| `{run}` | 64 | 40 | 62 | 0 | 59 ({59 / 64:.1%}) | parse wrong 2, grasp slipped 2, misplaced 1 |"]
+    assert stress_section(tmp_path / "none") == []
+
+
+def test_the_report_tabulates_cluster_speedups_in_date_order():
+    from vcc.report import cluster_section
+
+    def run(date, model, one, workers_s):
+        return {"benchmark": "cluster", "date": date, "model": model, "concepts": ["a", "b"], "budget": 1000,
+                "single": {"seconds": one}, "cluster": {"workers": 2, "seconds": workers_s},
+                "speedup": round(one / workers_s, 2), "results_agree": True}
+
+    lines = cluster_section([("b.json", run("2031-02-01", "library", 9.0, 6.0)),
+                             ("a.json", run("2031-01-01", "uniform", 1.0, 2.0))])
+    rows = [x for x in lines if x.startswith("| `")]
+    assert rows == ["| `a.json` | uniform | 2 x 1,000 | 1.0 | 2 | 2.0 | 0.5x | True |",
+                    "| `b.json` | library | 2 x 1,000 | 9.0 | 2 | 6.0 | 1.5x | True |"]
+    assert cluster_section([]) == []
+
+
 def test_the_report_tabulates_the_camera_sweep_of_the_latest_file():
     from vcc.report import camera_section
 
