@@ -8,7 +8,7 @@ from pathlib import Path
 
 from vccjax import runtime
 
-XLA_FLAG = "--xla_cpu_use_fusion_emitters=false"  # batched MJX 14x faster on CPU (docs/robot.md, "MJX on CPU")
+from robot.suite import XLA_FLAG
 
 
 def _program(a: argparse.Namespace):
@@ -126,6 +126,14 @@ def cmd_suite(a: argparse.Namespace) -> int:
     if a.scenarios < 1 or a.count < 1:
         raise ValueError("--scenarios and --count must be positive")
     shard = _shard(a.shard)
+    if a.workers is not None and a.cluster != "ray":
+        raise ValueError("--workers: only with --cluster ray")
+    if a.cluster == "ray":
+        if shard != (0, 1):
+            raise ValueError("--shard splits a suite between processes by hand; --cluster ray does it itself")
+        from vccjax.actor_pool import ray_module
+
+        ray_module()  # a missing extra fails now, with its message
     programs, names = _suite_programs(a)  # bad input ends here, before JAX and MuJoCo start
     print(f"{len(names)} concepts from {programs.source.kind} {programs.source.path or ''}, "
           f"{a.scenarios} scenarios each" + (f", shard {a.shard}" if a.shard != "0/1" else ""))
@@ -136,10 +144,17 @@ def cmd_suite(a: argparse.Namespace) -> int:
             raise ValueError(f"--out {a.out}: no such run folder")
         s = summarise(Path(a.out), programs, names, a.scenarios, a.seed)
     else:
-        _setup_mjx(a)
-        from robot.suite import run_suite
+        if a.cluster == "ray":  # batches rolled out on Ray workers, one core each (docs/cluster.md)
+            from robot.suite import _SuiteWorker, run_suite
+            from vccjax.actor_pool import ActorPool
 
-        s = run_suite(a.out, programs, names, a.scenarios, a.seed, shard=shard)
+            with ActorPool(_SuiteWorker, lambda slot: (slot,), a.workers) as pool:
+                s = run_suite(a.out, programs, names, a.scenarios, a.seed, pool=pool)
+        else:
+            _setup_mjx(a)
+            from robot.suite import run_suite
+
+            s = run_suite(a.out, programs, names, a.scenarios, a.seed, shard=shard)
     print("failures: " + (", ".join(f"{c} {n}" for c, n in s["failures"].items()) or "none"))
     p = s["parse"]
     print(f"parse: {p['objects_exact']} of {p['objects']} objects exact, {p['scenes_exact']} of {p['scenes']} scenes")
@@ -235,6 +250,11 @@ def add_commands(sub) -> None:
     u.add_argument("--status", action="store_true",
                    help="only summarise what the folder holds (writes summary.json), running no rollout")
     u.add_argument("--all-cores", action="store_true", help="let XLA use every core")
+    u.add_argument("--cluster", choices=["none", "ray"], default="none",
+                   help="'ray': roll the batches out on Ray workers, one core each; this process writes the "
+                        "records (joins $RAY_ADDRESS, or starts a local cluster; docs/cluster.md)")
+    u.add_argument("--workers", type=runtime.count(1, 4096),
+                   help="Ray workers (default: one per CPU of the cluster)")
     u.set_defaults(fn=cmd_suite)
 
     c = s.add_parser("perception", help="the arm camera's parse against the true tables, nominal and harder",

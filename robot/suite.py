@@ -34,6 +34,7 @@ TEN: tuple[str, ...] = (  # the first suite: stacking, touching, the pointer, a 
     "move_all_yellow_left+move_green_to_right_bottom_corner",  # composition: yellow aside, the green one away
 )
 BATCH = 32  # scenarios rolled out at once (whole concepts)
+XLA_FLAG = "--xla_cpu_use_fusion_emitters=false"  # batched MJX 14x faster on CPU (docs/robot.md, "MJX on CPU")
 
 
 def file_of(out: Path, name: str) -> Path:
@@ -90,10 +91,37 @@ def _settings(programs: Programs, name: str, scenarios: int, seed: int) -> dict:
             "program_sha256": program_sha256(programs.of(name)), "world_sha256": world_sha256()}
 
 
+class _SuiteWorker:
+    """One MJX rollout engine in its own process (a Ray actor, `vccjax.actor_pool`), on
+    one core (batched MJX on CPU is as fast on one: docs/robot.md, "MJX on CPU")."""
+
+    def __init__(self, slot: int):
+        from vccjax import runtime
+        from vccjax.actor_pool import pin
+
+        pin(slot, 1)
+        runtime.prepare(xla_flags=[XLA_FLAG])
+        from robot.rollout import Bench
+
+        self.bench = Bench()
+
+    def pid(self) -> int:
+        import os
+
+        return os.getpid()
+
+    def roll(self, pairs: list) -> tuple[list, dict]:
+        start = time.perf_counter()
+        verdicts, info, _ = self.bench.run_pairs(pairs, pad_to=BATCH)
+        return verdicts, {**info, "wall_s": time.perf_counter() - start}
+
+
 def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scenarios: int = 8, seed: int = 0,
-              log: Callable[[str], None] = print, shard: tuple[int, int] = (0, 1)) -> dict:
+              log: Callable[[str], None] = print, shard: tuple[int, int] = (0, 1), pool=None) -> dict:
     """Run (or resume) `concepts` (this shard's share) into `out`; returns the summary
-    of every concept of `concepts` recorded there (also written as summary.json)."""
+    of every concept of `concepts` recorded there (also written as summary.json). With a
+    `pool` (`vccjax.actor_pool.ActorPool` of `_SuiteWorker`), the batches are rolled out
+    on its workers and this process writes every record as its batch comes back."""
     from tqdm import tqdm
 
     from robot.judge import Verdict
@@ -112,8 +140,7 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
     concepts = list(dict.fromkeys(concepts))  # a name given twice runs once
     mine = concepts[shard[0]::shard[1]]
     todo = [c for c in mine if not finished(file_of(out, c), **settings(c))]
-    bench = None
-    bar = tqdm(total=len(todo), desc="robot suite", unit="concept")
+    batches = []  # (the concepts, their drawn scenarios, verdicts known without a rollout)
     while todo:
         group, items, staged = [], [], {}
         while todo and (not group or len(items) + scenarios <= BATCH):
@@ -126,29 +153,42 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
                     items.append((name, program, draw(program, s)))
                 except SceneError as e:
                     staged.setdefault(name, {})[s] = Verdict(False, "no scenario", str(e), float("nan"), s)
-        start = time.perf_counter()
-        verdicts, info = [], {}
-        if items:
-            if bench is None:
-                from robot.rollout import Bench
+        batches.append((group, items, staged))
+    bar = tqdm(total=sum(len(g) for g, _, _ in batches), desc="robot suite", unit="concept")
 
-                bench = Bench()
-            verdicts, info, _ = bench.run_pairs([(p, sc) for _, p, sc in items], pad_to=BATCH)
+    def record(batch: int, verdicts: list, info: dict) -> None:
+        group, items, staged = batches[batch]
         for (name, _, sc), v in zip(items, verdicts, strict=True):
             staged.setdefault(name, {})[sc.seed] = v
-        info["wall_s"] = time.perf_counter() - start
         for name in group:
             runs = [staged[name][s] for s in sorted(staged[name])]
             program = programs.of(name)
             texts = [p.text() for p in (program if isinstance(program, list) else [program])]
-            record = {"concept": name, **settings(name), "programs": texts, "batch": {"concepts": group, **info},
-                      "success": sum(v.success for v in runs),
-                      "failures": dict(Counter(v.cause for v in runs if not v.success)),
-                      "records": [v.record() for v in runs]}
-            write_record(file_of(out, name), record)
-            log(f"{name}: {record['success']} of {scenarios}")
+            rec = {"concept": name, **settings(name), "programs": texts, "batch": {"concepts": group, **info},
+                   "success": sum(v.success for v in runs),
+                   "failures": dict(Counter(v.cause for v in runs if not v.success)),
+                   "records": [v.record() for v in runs]}
+            write_record(file_of(out, name), rec)
+            log(f"{name}: {rec['success']} of {scenarios}")
             bar.update(1)
         summarise(out, programs, concepts, scenarios, seed)  # a partial run reads as far as it went
+
+    rolled = [b for b, (_, items, _) in enumerate(batches) if items]
+    for b in set(range(len(batches))) - set(rolled):
+        record(b, [], {"wall_s": 0.0})  # every scenario refused before a rollout
+    if pool is not None:
+        pool.map("roll", [([(p, sc) for _, p, sc in batches[b][1]],) for b in rolled],
+                 lambda i, got: record(rolled[i], *got))
+    else:
+        bench = None
+        for b in rolled:
+            if bench is None:
+                from robot.rollout import Bench
+
+                bench = Bench()
+            start = time.perf_counter()
+            verdicts, info, _ = bench.run_pairs([(p, sc) for _, p, sc in batches[b][1]], pad_to=BATCH)
+            record(b, verdicts, {**info, "wall_s": time.perf_counter() - start})
     bar.close()
     return summarise(out, programs, concepts, scenarios, seed)
 

@@ -167,3 +167,45 @@ def test_stress_resumes_from_its_batch_records_without_redoing_them(tmp_path, mo
     assert kept["seed"] == 3 and len(kept["concepts"]) == BATCH and kept["verdicts"][0]["max_error_m"] is None
     run_stress(tmp_path, reference, rollouts=BATCH, seed=4, log=lambda _: None)
     assert calls == [BATCH, BATCH, BATCH]  # another seed: redone
+
+
+def test_a_suite_on_a_worker_pool_writes_what_one_process_writes(tmp_path, monkeypatch):
+    """`vcc robot suite --cluster ray`: the batches go to the pool's workers and come back
+    in any order; this process writes the same records as a run on its own (a fake pool
+    here; the pool itself is tested with Ray in tests/search/test_cluster.py)."""
+    import json
+
+    import robot.rollout
+    from robot.judge import Verdict
+    from robot.sources import Programs
+    from robot.suite import run_suite
+
+    def verdicts(pairs):  # scenario by scenario, as a rollout would: the same wherever it runs
+        return [Verdict(s.seed % 3 != 1, None if s.seed % 3 != 1 else "misplaced", "", 0.0, s.seed) for _, s in pairs]
+
+    class FakeBench:
+        def run_pairs(self, items, keep=False, pad_to=None):
+            return verdicts(items), {"compile_s": 0.0, "rollout_s": 0.0}, []
+
+    class FakePool:
+        def __init__(self):
+            self.batches = []
+
+        def map(self, method, chunks, done):
+            assert method == "roll"
+            for i in reversed(range(len(chunks))):  # the last batch back first
+                (pairs,) = chunks[i]
+                self.batches.append(len(pairs))
+                done(i, (verdicts(pairs), {"compile_s": 0.0, "rollout_s": 0.0, "wall_s": 0.0}))
+
+    monkeypatch.setattr(robot.rollout, "Bench", FakeBench)
+    names = ["move_green_to_right_bottom_corner", "move_all_yellow_left", "move_bottom_to_pointed"]
+    pool = FakePool()
+    alone = run_suite(tmp_path / "alone", Programs("reference"), names, scenarios=16, log=lambda _: None)
+    spread = run_suite(tmp_path / "pool", Programs("reference"), names, scenarios=16, log=lambda _: None, pool=pool)
+    assert pool.batches == [16, 32]  # whole concepts, at most 32 scenarios a batch
+    assert spread["success"] == alone["success"] and spread["failures"] == alone["failures"]
+    assert spread["rollouts"] == alone["rollouts"] == 48
+    for name in names:
+        a, b = (json.loads((tmp_path / d / f"{name}.json").read_text()) for d in ("alone", "pool"))
+        assert a["records"] == b["records"] and a["programs"] == b["programs"]

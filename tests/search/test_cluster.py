@@ -103,3 +103,26 @@ def test_vcc_induce_on_a_local_cluster_writes_one_row_per_concept(tmp_path):
                           timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
     assert sorted(c for c, _, _ in _rows(out)) == sorted(names.split(","))
+
+
+def test_a_chunk_that_keeps_killing_its_worker_ends_the_run_with_its_name():
+    """A lost host is retried; a chunk whose worker dies every time is a bug: after
+    MAX_TRIES reruns the pool stops with a line naming the chunk, the other chunks done."""
+    from vccjax.actor_pool import MAX_TRIES, ActorPool
+
+    class Echo:  # defined here: Ray ships it to the workers by value
+        def pid(self) -> int:
+            return os.getpid()
+
+        def twice(self, x: int) -> int:
+            if x < 0:
+                os._exit(1)  # the worker process dies under this chunk
+            return 2 * x
+
+    got = {}
+    with ActorPool(Echo, lambda slot: (), workers=2) as pool:
+        pool.map("twice", [(1,), (2,), (3,)], got.__setitem__)
+        assert got == {0: 2, 1: 4, 2: 6} and pool.retried == 0
+        with pytest.raises(RuntimeError, match=f"chunk 1 of 3 killed its worker {MAX_TRIES + 1} times"):
+            pool.map("twice", [(5,), (-1,), (7,)], got.__setitem__)
+        assert pool.retried == MAX_TRIES

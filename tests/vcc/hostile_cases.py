@@ -489,6 +489,9 @@ robot("robot-run-video-dir", *RR, "--video", "{tmp}/dir.mp4", writes=["{tmp}/dir
 robot("robot-run-frames-parent-file", *RR, "--frames", "{file}/f.png", writes=["{file}"], slow=True)
 RS = {"out": "{tmp}/rs", "concepts": ARM, "scenarios": "1"}
 robot("robot-suite-out-missing", "robot", "suite", *_flags(RS, out=None))
+robot("robot-suite-workers-without-cluster", "robot", "suite", *_flags(RS, workers="2"), writes=["{tmp}/rs"])
+robot("robot-suite-cluster-bad", "robot", "suite", *_flags(RS, cluster="dask"), writes=["{tmp}/rs"])
+robot("robot-suite-cluster-shard", "robot", "suite", *_flags(RS, cluster="ray", shard="0/2"), writes=["{tmp}/rs"])
 robot("robot-suite-count-zero", "robot", "suite", *_flags(RS, concepts=None, count="0"), writes=["{tmp}/rs"])
 robot("robot-suite-count-negative", "robot", "suite", *_flags(RS, concepts=None, count="-1"), writes=["{tmp}/rs"])
 robot("robot-suite-scenarios-zero", "robot", "suite", *_flags(RS, scenarios="0"), writes=["{tmp}/rs"])
