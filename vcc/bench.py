@@ -318,7 +318,8 @@ def add_commands(sub) -> None:
     g = bsub.add_parser("report", help="regenerate benchmarks/REPORT.md from the measured results (runs nothing)")
     _report_flags(g)
     g.set_defaults(fn=cmd_bench_report)
-    from vcc import cluster_bench, learn_bench
+    from vcc import cluster_bench, learn_bench, misses
 
     learn_bench.add_command(bsub)
     cluster_bench.add_command(bsub)
+    misses.add_command(bsub)

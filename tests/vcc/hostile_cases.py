@@ -558,6 +558,9 @@ robot("robot-stress-seed-negative", "robot", "stress", *_flags(ST, seed="-1"), w
 # ---- vcc bench search / emulator / reproduce / report / learn ---------------------------------
 BS = {"concepts": "remove_top_obj", "budget": "1", "width": "1", "out": "{tmp}/bs.json"}
 W_BS = ["{tmp}/bs.json"]
+case("bench-misses-run-not-a-run", "bench", "misses", "--run", "{dir}", "--out", "{tmp}/m.json", writes=["{tmp}/m.json"])
+case("bench-misses-run-missing", "bench", "misses", "--run", "{missing}", "--out", "{tmp}/m.json",
+     writes=["{tmp}/m.json"])
 BC = {"concepts": "remove_top_obj", "budget": "1", "width": "2", "out": "{tmp}/bc.json"}
 case("bench-cluster-workers-zero", "bench", "cluster", *_flags(BC, workers="0"), writes=["{tmp}/bc.json"])
 case("bench-cluster-out-dir", "bench", "cluster", *_flags(BC, out="{tmp}/dir.json"), writes=["{tmp}/bc.json"])

@@ -335,3 +335,42 @@ def test_bench_search_scalar_side_can_run_a_sample(tmp_path, capsys):
     expected = (b["programs_run"] / b["seconds"]) / (s["programs_run"] / s["seconds"])
     assert abs(r["ratio"] - expected) <= 0.03 * expected + 0.01  # from the seconds as stored (rounded)
     assert "scalar over 1" in capsys.readouterr().out
+
+
+def test_bench_misses_names_the_cheapest_known_program_and_its_rank(tmp_path):
+    """A missed concept is spelt by its cheapest known program (its reference program, or a
+    cheaper one another run found) under the run's last model; the rank is the same
+    whatever the budget, and it is past a budget of 1 (at least one program is cheaper)."""
+    from search.model import MarkovModel, Vocabulary
+    from vcc.misses import why_missed
+    from vccjax.world.concepts import reference_program
+
+    missed, found = "remove_top_obj", "remove_bottom_obj"
+    size = Vocabulary().size
+
+    def run(folder, budget):
+        folder.mkdir()
+        settings = {"budget": budget, "order": 1, "args": "oracle", "subroutines": True, "epsilon": 0.1,
+                    "max_iterations": 1, "max_subroutines": 100, "delta": 0.01}
+        (folder / "run.json").write_text(json.dumps({"format": "vccjax-induce", "version": 1, "settings": settings}))
+        rows = [{"concept": missed, "found": False, "iteration": 0},
+                {"concept": found, "found": True, "iteration": 0, "program": reference_program(found).text()}]
+        (folder / "results.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+        (folder / "model-0.json").write_text(json.dumps({"iteration": 0, "order": 1, "subroutines": [],
+                                                         "logp": MarkovModel.uniform(size, 1).logp.tolist()}))
+        return folder
+
+    small, large = why_missed(run(tmp_path / "small", 1)), why_missed(run(tmp_path / "large", 10**12))
+    assert small["found"] == 1 and small["concepts"] == 2 and [r["concept"] for r in small["misses"]] == [missed]
+    a, b = small["misses"][0], large["misses"][0]
+    assert a["program"] == "reference" and a["rank"] == b["rank"] > 1 and a["nats"] == b["nats"] > 0
+    assert (a["why"], b["why"]) == ("past the budget", "within the budget")
+    # a shorter program found by another run for the same concept is the one spelt
+    ref = reference_program(missed)
+    other = tmp_path / "other"
+    other.mkdir()
+    shorter = "scene_parse; fixate(top); top_down_attend"
+    assert len(shorter.split(";")) < len(ref.ops)
+    (other / "results.jsonl").write_text(json.dumps({"concept": missed, "found": True, "program": shorter}) + "\n")
+    c = why_missed(tmp_path / "large", [tmp_path / "other"])["misses"][0]
+    assert c["program"] == shorter and c["nats"] < b["nats"] and c["rank"] < b["rank"]
