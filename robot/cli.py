@@ -145,10 +145,10 @@ def cmd_suite(a: argparse.Namespace) -> int:
         s = summarise(Path(a.out), programs, names, a.scenarios, a.seed)
     else:
         if a.cluster == "ray":  # batches rolled out on Ray workers, one core each (docs/cluster.md)
-            from robot.suite import _SuiteWorker, run_suite
+            from robot.suite import SuiteWorker, run_suite
             from vccjax.actor_pool import ActorPool
 
-            with ActorPool(_SuiteWorker, lambda slot: (slot,), a.workers) as pool:
+            with ActorPool(SuiteWorker, lambda slot: (slot,), a.workers) as pool:
                 s = run_suite(a.out, programs, names, a.scenarios, a.seed, pool=pool)
         else:
             _setup_mjx(a)

@@ -91,7 +91,7 @@ def _settings(programs: Programs, name: str, scenarios: int, seed: int) -> dict:
             "program_sha256": program_sha256(programs.of(name)), "world_sha256": world_sha256()}
 
 
-class _SuiteWorker:
+class SuiteWorker:
     """One MJX rollout engine in its own process (a Ray actor, `vccjax.actor_pool`), on
     one core (batched MJX on CPU is as fast on one: docs/robot.md, "MJX on CPU")."""
 
@@ -120,7 +120,7 @@ def run_suite(out: str | Path, programs: Programs, concepts: Sequence[str], scen
               log: Callable[[str], None] = print, shard: tuple[int, int] = (0, 1), pool=None) -> dict:
     """Run (or resume) `concepts` (this shard's share) into `out`; returns the summary
     of every concept of `concepts` recorded there (also written as summary.json). With a
-    `pool` (`vccjax.actor_pool.ActorPool` of `_SuiteWorker`), the batches are rolled out
+    `pool` (`vccjax.actor_pool.ActorPool` of `SuiteWorker`), the batches are rolled out
     on its workers and this process writes every record as its batch comes back."""
     from tqdm import tqdm
 
