@@ -41,6 +41,7 @@ def why_missed(folder: Path, others: list[Path] = ()) -> dict:
     from search.arguments import argument_logp
     from search.chain import Chain
     from search.model import MarkovModel, Vocabulary
+    from search.parts import fits
     from vccjax.errors import DataFileError, read_json
     from vccjax.machine.instructions import NAMES, arg_domain
     from vccjax.world.concepts import reference_program
@@ -71,7 +72,10 @@ def why_missed(folder: Path, others: list[Path] = ()) -> dict:
                            if arg_domain(NAMES[o]) and not np.isfinite(logp[o][a])})
 
         best = None  # (nats, portions, program): the cheapest spelling of a known program
-        for p in [answer, *known.get(c, [])]:
+        pairs = ds.pairs(c, "train")
+        # another run's program counts only where it fits this run's examples (it may come
+        # from fewer or other examples)
+        for p in [answer, *(k for k in known.get(c, []) if fits(k, pairs))]:
             spelt = None if unpredicted(p) else chain.cheapest(p.ops, p.args)
             if spelt is not None and (best is None or spelt[0] < best[0]):
                 best = (spelt[0], spelt[1], p)
