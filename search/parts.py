@@ -14,7 +14,12 @@ learned on the 546 rarely saw the join. When the search finds nothing, `learn_in
    first part made, the output), recursively up to `max_parts` parts;
 3. joins the parts (the rest's `scene_parse` dropped, a `reset_attn` between them where
    the join needs it) and keeps the join only if the reference machine runs it right on
-   every given pair: a program learned in parts is checked like any other.
+   every given pair: a program learned in parts is checked like any other;
+4. of the joins that fit, keeps the most probable under the whole pairs' chain (least
+   description length), as a whole search keeps the cheapest program that fits: every
+   first part is tried, since the one of most progress need not lead to the cheapest
+   join (recolor-then-remove makes more progress than remove-then-recolor, and the
+   two can fit the same pairs).
 
 The first parts are judged on the host by the scalar reference (`ScalarBackend` with
 another judge); the rest is an ordinary search on the caller's searcher. Each search
@@ -156,11 +161,11 @@ def learn_in_parts(pairs: Sequence[tuple[Scene, Scene]], chain_of: Callable[[Seq
     allowance = allowance or _Allowance(settings.allowance)
     if settings.max_parts < 2 or not allowance.take(settings.budget):
         return None, 0
-    firsts, judged = first_parts(chain_of(pairs), pairs, settings, cfg)
-    best: InParts | None = None
-    others: list[Program] = []
+    whole = chain_of(pairs)
+    firsts, judged = first_parts(whole, pairs, settings, cfg)
+    fitting: list[tuple[float, Program, tuple[Program, ...]]] = []  # (nats, join, parts), in the order found
     for first in firsts:
-        if (best is not None and (len(others) >= settings.rivals)) or not allowance.take(settings.budget):
+        if not allowance.take(settings.budget):
             break
         made = outcomes(first, [a for a, _ in pairs], cfg)
         rest_pairs = [(m, b) for m, (_, b) in zip(made, pairs, strict=True)]
@@ -187,12 +192,17 @@ def learn_in_parts(pairs: Sequence[tuple[Scene, Scene]], chain_of: Callable[[Seq
                 tails = [(deeper.program, deeper.parts)] + [(p, (p,)) for p in deeper.rivals]
         for tail, tail_parts in tails:
             joined = next((j for j in joins(first, tail) if fits(j, pairs, cfg)), None)
-            if joined is None or (best is not None and (joined == best.program or joined in others)):
-                continue
-            if best is None:
-                best = InParts(joined, (first,) + tail_parts)
-            elif len(others) < settings.rivals:
-                others.append(joined)
-    if best is None:
+            if joined is not None and all(joined != f[1] for f in fitting):
+                fitting.append((join_nats(whole, joined), joined, (first,) + tail_parts))
+    if not fitting:
         return None, judged
-    return dataclasses.replace(best, rivals=tuple(others)), judged
+    fitting.sort(key=lambda f: f[0])  # stable: equal lengths keep the order found
+    (_, program, parts), rest_fits = fitting[0], fitting[1:]
+    return InParts(program, parts, tuple(f[1] for f in rest_fits[: settings.rivals])), judged
+
+
+def join_nats(chain: Chain, program: Program) -> float:
+    """A join's description length under `chain` (its cheapest spelling; inf where the
+    chain rules out an argument it uses)."""
+    spelt = chain.cheapest(program.ops, program.args)
+    return math.inf if spelt is None else float(spelt[0])

@@ -8,8 +8,8 @@ import random
 
 import pytest
 
-from search.learn import LearnSettings, learn
-from search.parts import gains, joins
+from search.learn import LearnSettings, chain_for, learn
+from search.parts import fits, gains, join_nats, joins
 from search.scalar import ScalarExplorer
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.machine.program import parse
@@ -20,6 +20,10 @@ from vccjax.world.dataset import dataset_for
 TAU = DEFAULT_CONFIG.tau
 TWO_PARTS = ("scene_parse; fixate(top); top_down_attend; fill_color(red); reset_attn; "
              "fixate(bottom); top_down_attend; fill_color(blue)")
+REMOVE_THEN_RECOLOR = ("scene_parse; fixate(left); top_down_attend; remove_from_imagine_buffer; "
+                       "fixate(right); top_down_attend; fill_color(yellow)")
+RECOLOR_THEN_REMOVE = ("scene_parse; fixate(right); top_down_attend; fill_color(yellow); reset_attn; "
+                       "fixate(left); top_down_attend; remove_from_imagine_buffer")
 
 
 def _obj(shape, color, x, y):
@@ -146,3 +150,26 @@ def test_from_few_pairs_the_other_joins_that_fit_come_back_as_rivals(two_part_pa
     # two pairs fit joins that part ways on fresh scenes (one recolours "the red object"
     # blue where another recolours the bottom one): the pairs are reported ambiguous
     assert got.ambiguous
+
+
+def test_of_the_joins_that_fit_the_most_probable_is_kept():
+    """Remove the left-most object, recolor the right-most: recoloring first makes more
+    progress (an object brought right, against one removed), and both orders fit the
+    pairs; the join kept is the one of least description length, as a whole search keeps
+    the cheapest program."""
+    data = dataset_for(["remove_bottom_obj"], 0, None, progress=False)
+    truth, pairs = parse(REMOVE_THEN_RECOLOR), []
+    for a, _ in data.pairs("remove_bottom_obj", "train"):
+        m = RefMachine(a).run(truth)
+        if not m.failed and scene_distance(a, m.output_scene(), TAU) == 3:  # one removed, one recolored
+            pairs.append((a, m.output_scene()))
+    train = pairs[:6]
+    assert len(train) == 6
+    assert not learn(train, LearnSettings(budget=20_000, rival_budget=0, parts=1), ScalarExplorer(width=1)).found
+    got = learn(train, LearnSettings(budget=20_000, rival_budget=0), ScalarExplorer(width=1))
+    assert got.found and len(got.parts) == 2
+    chain = chain_for(train, LearnSettings())[0]
+    orders = [parse(REMOVE_THEN_RECOLOR), parse(RECOLOR_THEN_REMOVE)]
+    assert all(fits(p, train) for p in orders)
+    assert join_nats(chain, got.program) == min(join_nats(chain, p) for p in orders)
+    assert join_nats(chain, orders[0]) != join_nats(chain, orders[1])  # the choice is not a tie
