@@ -207,6 +207,31 @@ def settle(searched: Result, chain: Chain, pairs: Sequence[tuple[Scene, Scene]],
                                text=text_of(chain, portions), dl_nats=nats, dl_bins=bins, rank=rank)
 
 
+def from_uniform(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings,
+                 searcher: Searcher, start: tuple[Vocabulary, MarkovModel, str],
+                 progress: Callable[[int], None] | None = None, asked: Sequence[Program] = (),
+                 log: Callable[[str], None] | None = None) -> tuple[Result, Chain | None]:
+    """`searched` (a search from a library that found nothing) tried again from a uniform
+    start over a tenth of the budget: a concept unlike the 546 can lie among a uniform
+    model's first programs while the library ranks it far down (it rarely saw the
+    sequence). Returns (the result, the uniform chain where that search found it, else
+    None); the programs judged add up. A search that started uniform is not repeated."""
+    if searched.found or start[2] == "uniform":
+        return searched, None
+    uniform = model_for("uniform")
+    chain = chain_for(pairs, settings, uniform)[0]
+    if log:
+        log(f"nothing within the budget from the library: the first {max(1, settings.budget // 10):,} "
+            "programs from a uniform start")
+    t0 = time.perf_counter()
+    got = settle(searcher.search(chain, Task.from_pairs(pairs), max(1, settings.budget // 10), progress),
+                 chain, pairs, asked)
+    got = dataclasses.replace(got, programs=searched.programs + got.programs,
+                              seconds=searched.seconds + time.perf_counter() - t0)
+    return (got, chain) if got.found else (dataclasses.replace(searched, programs=got.programs,
+                                                                seconds=got.seconds), None)
+
+
 def in_parts(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searcher: Searcher,
              start: tuple[Vocabulary, MarkovModel, str] | None = None,
              log: Callable[[str], None] | None = None) -> tuple[Result, tuple[Program, ...]]:
@@ -272,6 +297,9 @@ def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searche
         searcher = Explorer(width=1)
     task = Task.from_pairs(pairs)
     first = settle(searcher.search(chain, task, settings.budget, progress), chain, pairs, asked)
+    first, uniform = from_uniform(first, pairs, settings, searcher, start, progress, asked, log)
+    if uniform is not None:
+        chain, name = uniform, "uniform"
     first, parts = in_parts(first, pairs, settings, searcher, start, log)
     result = first if parts else with_rivals(first, chain, task, settings, searcher, progress, [a for a, _ in pairs])
     verdict, scenes = verdict_for(result, pairs, settings)

@@ -32,8 +32,10 @@ from vccjax.records import append_line
 STARTS = ("library", "uniform")
 # 2: the answered question is learned again with the programs it was about, and fresh
 # scenes may hold one object more than the examples; 3: what no whole program fits is
-# learned in parts (`search.parts`) (a run of another protocol is refused)
-PROTOCOL = 3
+# learned in parts (`search.parts`); 4: of the joins of parts that fit, the most probable,
+# and what the library's search misses is tried from a uniform start over a tenth of the
+# budget before the parts (`search.learn.from_uniform`) (a run of another protocol is refused)
+PROTOCOL = 4
 # What every results line must hold (the key of `_key`, and whether it was found).
 RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 
@@ -67,7 +69,7 @@ def _open_run(folder: Path, meta: dict) -> list[dict]:
 def cmd_bench_learn(a: argparse.Namespace) -> int:
     from search.explore import Explorer
     from search.induce import generalization
-    from search.learn import LearnSettings, chain_for, in_parts, learn, model_for
+    from search.learn import LearnSettings, chain_for, from_uniform, in_parts, learn, model_for
     from search.task import Task
     from vccjax.machine.config import DEFAULT_CONFIG
     from vccjax.world.concepts import read_programs
@@ -116,14 +118,15 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
             jobs = [(chain_for(ds.pairs(c, "train")[:k], settings, starts[start])[0],
                      Task.from_pairs(ds.pairs(c, "train")[:k])) for c in todo]
 
-            def record(c: str, r, parts: tuple, k=k, start=start) -> None:
+            def record(c: str, r, parts: tuple, k=k, start=start, uniform: bool = False) -> None:
                 right = generalization(r.program, ds.pairs(c, "test"), tau) if r.found else 0
                 write({"kind": "learn", "concept": c, "examples": k, "start": start, "found": r.found,
                        "right": bool(r.found and right == len(ds.pairs(c, "test"))), "test_right": right,
                        "program": r.program.text() if r.found else None, "rank": r.rank, "parts": len(parts),
-                       "programs": r.programs, "seconds": round(r.seconds, 3)})
+                       "programs": r.programs, "seconds": round(r.seconds, 3), "from_uniform": uniform})
                 if not a.quiet:
                     print(f"  {c}: {'found' if r.found else 'not found'}"
+                          + (" from a uniform start" if uniform else "")
                           + (f" in {len(parts)} parts" if parts else "")
                           + (f", {right}/{len(ds.pairs(c, 'test'))} test pairs" if r.found else ""))
 
@@ -131,7 +134,9 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
             explorer.search_many(jobs, a.budget, lambda j, r, todo=todo: (
                 record(todo[j], r, ()) if r.found else unfound.append((todo[j], r))))
             for c, r in unfound:  # one at a time: each part's search is a search of its own
-                record(c, *in_parts(r, ds.pairs(c, "train")[:k], settings, explorer, starts[start]))
+                r, uniform = from_uniform(r, ds.pairs(c, "train")[:k], settings, explorer, starts[start])
+                record(c, *in_parts(r, ds.pairs(c, "train")[:k], settings, explorer, starts[start]),
+                       uniform=uniform is not None)
     # asking back: two examples, the library, rivals on (as vcc learn runs)
     k = a.ask_examples
     for c in names:
@@ -178,7 +183,10 @@ def summarise(records: list[dict], names: list[str], examples: list[int], ask: i
             table[f"{s}, {k} examples"] = {"concepts": len(rows), "found": sum(r["found"] for r in rows),
                                            "right": sum(r["right"] for r in rows),
                                            "in_parts": sum(r["found"] and r.get("parts", 0) > 0 for r in rows),
-                                           "right_in_parts": sum(r["right"] and r.get("parts", 0) > 0 for r in rows)}
+                                           "right_in_parts": sum(r["right"] and r.get("parts", 0) > 0 for r in rows),
+                                           "from_uniform": sum(r["found"] and bool(r.get("from_uniform")) for r in rows),
+                                           "right_from_uniform": sum(r["right"] and bool(r.get("from_uniform"))
+                                                                    for r in rows)}
     asks = [r for r in records if r["kind"] == "ask" and r["examples"] == ask]
     wrong = [r for r in asks if r["found"] and not r["right"]]
     right = [r for r in asks if r["right"]]

@@ -248,3 +248,35 @@ def test_a_rerun_with_the_answer_weighs_the_programs_asked_about(data, tmp_path,
     assert main(["learn", str(folder), "--out", str(out), *QUICK]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "concept.json" in err[0]
+
+
+def test_what_the_library_misses_is_tried_from_a_uniform_start_over_a_tenth_of_the_budget():
+    """A start that all but rules out `set_shape_attn` finds nothing for a concept that
+    picks its object by shape; the uniform start's first tenth of the budget finds a
+    program that fits every pair, the judged programs add up, and a start that was
+    uniform already is not searched again."""
+    from search.chain import Chain
+    from search.learn import chain_for, from_uniform, model_for
+    from search.model import MarkovModel, Vocabulary
+    from search.task import Task
+    from vccjax.machine.instructions import OP
+
+    concept = "change_target_obj_to_given_color"
+    pairs = dataset_for([concept], 0, None, progress=False).pairs(concept, "train")[:4]
+    size = Vocabulary().size
+    logp = np.full((size + 1, size + 1), -np.log(size + 1))
+    logp[:, OP["set_shape_attn"]] = -60.0  # `set_shape_attn` past any budget here
+    skewed = (Vocabulary(), MarkovModel(logp, 1, 0.0), "skewed")
+    settings = LearnSettings(budget=200_000, rival_budget=0, parts=1)
+    chain: Chain = chain_for(pairs, settings, skewed)[0]
+    searcher = ScalarExplorer(width=1)
+    missed = searcher.search(chain, Task.from_pairs(pairs), settings.budget)
+    assert not missed.found
+    got, uniform = from_uniform(missed, pairs, settings, searcher, skewed)
+    assert got.found and uniform is not None and got.programs > missed.programs
+    assert got.rank <= settings.budget // 10
+    for a, b in pairs:
+        m = RefMachine(a).run(got.program)
+        assert not m.failed and scenes_match(m.output_scene(), b, DEFAULT_CONFIG.tau)
+    again, none = from_uniform(missed, pairs, settings, searcher, model_for("uniform"))
+    assert again is missed and none is None
