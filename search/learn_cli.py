@@ -244,7 +244,8 @@ def add_commands(sub) -> None:
     p.add_argument("--budget", type=runtime.count(1, 10**10), default=500_000,
                    help="programs searched at most (default 500000)")
     p.add_argument("--library", default="shipped",
-                   help="'shipped' (default: learned on the 546), 'uniform' (from scratch) or a library file")
+                   help="'shipped' (default: learned on the 546), 'uniform' (from scratch) or a library file; "
+                        "what a library's search misses is searched from scratch over a tenth of the budget")
     p.add_argument("--args", choices=["predicted", "uniform"], default="predicted",
                    help="arguments: predicted by the CNN from the pairs (default) or uniform")
     p.add_argument("--fixate", help="the teacher's hint: where to look first (left, right, top, bottom, center; "

@@ -24,7 +24,7 @@ learned on the 546 rarely saw the join. When the search finds nothing, `learn_in
 The first parts are judged on the host by the scalar reference (`ScalarBackend` with
 another judge); the rest is an ordinary search on the caller's searcher. Each search
 covers a tenth of `vcc learn`'s budget, and all of them together at most the budget
-again, so a concept that cannot be learned costs at most twice the plain search.
+again, so parts cost at most as much as the plain search they follow.
 """
 
 from __future__ import annotations
