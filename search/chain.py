@@ -142,9 +142,11 @@ class Chain:
         return rest
 
     # ---- counting ----------------------------------------------------------------------
-    def count_table(self, budget: int, max_bins: int | None = None) -> np.ndarray:
+    def count_table(self, budget: int, max_bins: int | None = None,
+                    root: tuple[int, int] | None = None) -> np.ndarray:
         """Programs from the start with cost <= b, for b = 0.. until `budget` is reached
-        (cumulative counts; the last entry is the first >= budget)."""
+        (cumulative counts; the last entry is the first >= budget). `root` (last token,
+        syntax state) counts the continuations of a prefix ending there instead."""
         max_bins = max_bins or int(200 / self.delta)
         v1 = self.end + 1
         # classes: (token, arg bins) with multiplicity
@@ -165,7 +167,8 @@ class Chain:
         rows = v1 * N_SYN
         end_cost = np.full(rows, np.iinfo(np.int64).max)
         end_cost[OUTSIDE::N_SYN] = self.trans_bins[:, self.end]
-        root = self.end * N_SYN + NOT_STARTED
+        last, syn = root if root is not None else (self.end, NOT_STARTED)
+        start = last * N_SYN + syn
         table = np.zeros((rows, 1024))
         counts = []
         for b in range(max_bins + 1):
@@ -174,8 +177,8 @@ class Chain:
             ok = off <= b
             vals = table[dst[ok], b - off[ok]] * mul[ok]
             table[:, b] = (end_cost <= b) + np.bincount(src[ok], weights=vals, minlength=rows)
-            counts.append(table[root, b])
-            if table[root, b] >= budget:
+            counts.append(table[start, b])
+            if table[start, b] >= budget:
                 break
         return np.array(counts)
 
@@ -222,19 +225,20 @@ class Chain:
 _TABLES: dict[bytes, np.ndarray] = {}
 
 
-def cutoff_for_budget(chain: Chain, budget: int) -> tuple[int, np.ndarray]:
+def cutoff_for_budget(chain: Chain, budget: int, root: tuple[int, int] | None = None) -> tuple[int, np.ndarray]:
     """The description-length cutoff (bins) of the `budget` most probable programs, and the
-    cumulative count table (rank of a program of cost b = table[b - 1] + 1).
+    cumulative count table (rank of a program of cost b = table[b - 1] + 1); with `root`
+    (last token, syntax state), of a prefix's `budget` most probable continuations.
 
     The table depends only on the model's transition costs, the syntax and how many
     portions each token has at each argument cost, so concepts whose argument
     distributions differ only in which values they favour share it (cached)."""
     classes, mult = np.unique(chain.tok.astype(np.int64) * (1 << 32) + chain.argbins, return_counts=True)
     key = hashlib.sha256(b"".join(np.ascontiguousarray(a).tobytes() for a in (
-        np.array([budget, chain.end]), chain.trans_bins, chain.next_syn, classes, mult))).digest()
+        np.array([budget, chain.end, *(root or (-1, -1))]), chain.trans_bins, chain.next_syn, classes, mult))).digest()
     if key not in _TABLES:
         if len(_TABLES) > 256:
             _TABLES.clear()
-        _TABLES[key] = chain.count_table(budget)
+        _TABLES[key] = chain.count_table(budget, root=root)
     table = _TABLES[key]
     return len(table) - 1, table

@@ -22,7 +22,7 @@ their requests together (`search.lockstep`).
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Generator, Hashable
+from collections.abc import Callable, Generator, Hashable, Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -80,8 +80,9 @@ class Alternatives(NamedTuple):
 class _Budget:
     """The cutoff and the programs counted against the budget, as the search lowers it."""
 
-    def __init__(self, chain: Chain, budget: int, alternatives: Alternatives | None = None):
-        self.b_star, self.counts = cutoff_for_budget(chain, budget)
+    def __init__(self, chain: Chain, budget: int, alternatives: Alternatives | None = None,
+                 root: tuple[int, int] | None = None):
+        self.b_star, self.counts = cutoff_for_budget(chain, budget, root)
         cheaper = int(self.counts[self.b_star - 1]) if self.b_star > 0 else 0
         self.quota = budget - cheaper  # programs of cost exactly b* still allowed
         self.cutoff = self.b_star  # the most a program may cost (bins)
@@ -153,14 +154,36 @@ def _one_per_behaviour(best: tuple, fits: list[tuple]) -> list[tuple]:
 
 def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chunk: int, slice_size: int,
                 progress: Callable[[int], None] | None = None,
-                alternatives: Alternatives | None = None) -> Generator[Request, Reply, Outcome]:
+                alternatives: Alternatives | None = None,
+                prefix: Sequence[int] = ()) -> Generator[Request, Reply, Outcome]:
     """The search of one concept as a coroutine: yields a `Request` for each slice of up
     to `slice_size` children, receives the backend's `Reply`; returns the `Outcome`.
-    `backend` is used for root states and `take` only (the caller applies the requests)."""
-    limits = _Budget(chain, budget, alternatives)
-    frames = [_Frame(backend.root_states(task), np.array([chain.end]), np.array([NOT_STARTED]), np.array([0]),
-                     np.full((1, MAX_PORTIONS), -1, np.int32), 0)]
-    nodes = 0
+    `backend` is used for root states and `take` only (the caller applies the requests).
+
+    `prefix` (portions) makes it a search for continuations: the prefix is run (and
+    judged, where it may end), then every program that starts with it is enumerated by
+    the cost of what follows (conditioned on the prefix's last token), the budget
+    counting continuations, the empty one included. The programs found hold the prefix;
+    their costs and ranks are the continuation's."""
+    last, syntax = chain.end, NOT_STARTED
+    for z in prefix:
+        last, syntax = int(chain.tok[z]), int(chain.next_syn[chain.tok[z], syntax])
+        if syntax < 0:
+            raise ValueError("the prefix breaks the program syntax")
+    limits = _Budget(chain, budget, alternatives, (last, syntax) if len(prefix) else None)
+    path = np.full((1, MAX_PORTIONS), -1, np.int32)
+    path[0, : len(prefix)] = prefix
+    states = backend.root_states(task)
+    for k, z in enumerate(prefix):  # one child per step: the prefix's states on every example
+        ends = k == len(prefix) - 1 and syntax == OUTSIDE  # the prefix itself is a program to judge
+        reply = yield Request(chain, task, states, np.array([0]), np.array([z]), np.array([ends]))
+        if reply.failed[0]:  # no program through the prefix runs
+            return Outcome(None, k + 1, 0, limits.b_star, limits.counts, ())
+        if ends and limits.counts_program(int(chain.trans_bins[last, chain.end])) and reply.solved[0]:
+            limits.found(int(chain.trans_bins[last, chain.end]), path[0])
+        states = backend.take(reply.states, np.array([0]))
+    frames = [_Frame(states, np.array([last]), np.array([syntax]), np.array([0]), path, len(prefix))]
+    nodes = len(prefix)  # the prefix's steps
     end_bins = chain.trans_bins[:, chain.end]  # the cost of ending after each token
     while frames:
         frame = frames[-1]

@@ -47,14 +47,16 @@ class Searcher:
         self.width = width
 
     def search(self, chain: Chain, task: Task, budget: int,
-               progress: Callable[[int], None] | None = None, alternatives: Alternatives | None = None) -> Result:
+               progress: Callable[[int], None] | None = None, alternatives: Alternatives | None = None,
+               prefix: Sequence[int] = ()) -> Result:
         """The shortest program under the budget's cutoff that explains every example;
         `progress(n)` is told of each slice of n children run; with `alternatives`, other
-        programs that explain them too (`search.dfs.Alternatives`)."""
+        programs that explain them too (`search.dfs.Alternatives`); with `prefix`
+        (portions), the programs that start with it (`search.dfs.depth_first`)."""
         t0, compiled_before = time.perf_counter(), self.backend.compile_seconds
         self.backend.admit(task, [])
         search = depth_first(chain, task, budget, self.backend, chunk=self.chunk, slice_size=self.slice_size,
-                             progress=progress, alternatives=alternatives)
+                             progress=progress, alternatives=alternatives, prefix=prefix)
         try:
             request = next(search)
             while True:

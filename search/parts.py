@@ -21,6 +21,14 @@ learned on the 546 rarely saw the join. When the search finds nothing, `learn_in
    join (recolor-then-remove makes more progress than remove-then-recolor, and the
    two can fit the same pairs).
 
+When no join fits, the search goes on from where a first part leaves the machine: first
+parts are then judged by a graded measure (an object brought into its output's row or
+column counts half: `graded_distance`), and what follows each is searched as a
+*continuation* of it (`search.dfs.depth_first` with a prefix), from the machine state it
+leaves, the object still held and attended. "Take the pointed object down, then left"
+is then the first part and two more tokens, where a rest searched from a fresh
+`scene_parse` of the scenes made could not pick the held object out again.
+
 The first parts are judged on the host by the scalar reference (`ScalarBackend` with
 another judge); the rest is an ordinary search on the caller's searcher. Each search
 covers a tenth of `vcc learn`'s budget, and all of them together at most the budget
@@ -45,7 +53,7 @@ from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.instructions import OP
 from vccjax.machine.program import Program
 from vccjax.machine.reference import RefMachine
-from vccjax.machine.scene import Scene, scene_distance, scenes_match
+from vccjax.machine.scene import Scene, aligned_size, matching_size, scene_distance, scenes_match
 
 
 @dataclasses.dataclass(frozen=True)
@@ -57,6 +65,7 @@ class PartsSettings:
     candidates: int = 16  # first parts kept by their search, of which the `tries` of most progress
     margin_nats: float = 8.0  # first parts (and rests' rivals) at most this much less probable than the cheapest
     rivals: int = 0  # other fitting joins to keep, for the question back (0: stop at the first fit)
+    continuations: bool = True  # when no join fits, search on from graded first parts' machine states
 
 
 @dataclasses.dataclass(frozen=True)
@@ -70,35 +79,51 @@ class InParts:
 
 class ProgressBackend(ScalarBackend):
     """The scalar search whose judge accepts a program that brings the examples closer
-    to their outputs (fewer objects left unpaired): no example farther, some closer. (Not
-    every example closer: where the first part's change is already made, as a top object
+    to their outputs (fewer objects left unpaired; `graded`: also counting objects
+    brought into their row or column): no example farther, some closer. (Not every
+    example closer: where the first part's change is already made, as a top object
     already red, it rightly does nothing.)"""
 
+    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, graded: bool = False):
+        super().__init__(cfg)
+        self.graded = graded
+
     def solves(self, machines: list[RefMachine], task: Task) -> bool:
-        return gains([m.output_scene() for m in machines], task.pairs, self.cfg.tau) is not None
+        return gains([m.output_scene() for m in machines], task.pairs, self.cfg.tau, self.graded) is not None
 
 
-def gains(made: Sequence[Scene | None], pairs: Sequence[tuple[Scene, Scene]], tau: float) -> list[int] | None:
-    """Per pair, how much closer `made` is to the output than the input was, or None
-    unless the scenes made are progress: none failed, none farther, some closer, and
-    none with fewer objects than its output (no instruction adds an object back, so a
-    removal there could never be made good: removing a misplaced object is not progress)."""
+def graded_distance(a: Scene, b: Scene, tau: float) -> int:
+    """`scene_distance` in half objects, where an object paired with its output's only in
+    its row or column (`aligned_size`) counts half done: a move toward a corner that has
+    reached the bottom edge is progress."""
+    return 2 * (len(a.objects) + len(b.objects)) - 2 * (matching_size(a, b, tau) + aligned_size(a, b, tau))
+
+
+def gains(made: Sequence[Scene | None], pairs: Sequence[tuple[Scene, Scene]], tau: float,
+          graded: bool = False) -> list[int] | None:
+    """Per pair, how much closer `made` is to the output than the input was (`graded`:
+    by `graded_distance`), or None unless the scenes made are progress: none failed,
+    none farther, some closer, and none with fewer objects than its output (no
+    instruction adds an object back, so a removal there could never be made good:
+    removing a misplaced object is not progress)."""
     if any(m is None for m in made):
         return None
     if any(len(m.objects) < len(b.objects) for m, (_, b) in zip(made, pairs, strict=True)):
         return None
-    out = [scene_distance(a, b, tau) - scene_distance(m, b, tau) for m, (a, b) in zip(made, pairs, strict=True)]
+    distance = graded_distance if graded else scene_distance
+    out = [distance(a, b, tau) - distance(m, b, tau) for m, (a, b) in zip(made, pairs, strict=True)]
     return out if min(out) >= 0 and sum(out) > 0 else None
 
 
-def progress(program: Program, pairs: Sequence[tuple[Scene, Scene]], cfg: VCCConfig = DEFAULT_CONFIG) -> int:
+def progress(program: Program, pairs: Sequence[tuple[Scene, Scene]], cfg: VCCConfig = DEFAULT_CONFIG,
+             graded: bool = False) -> int:
     """Objects brought right over all pairs (`gains` summed; 0 when not progress)."""
-    made = gains(outcomes(program, [a for a, _ in pairs], cfg), pairs, cfg.tau)
+    made = gains(outcomes(program, [a for a, _ in pairs], cfg), pairs, cfg.tau, graded)
     return 0 if made is None else sum(made)
 
 
 def first_parts(chain: Chain, pairs: Sequence[tuple[Scene, Scene]], settings: PartsSettings,
-                cfg: VCCConfig = DEFAULT_CONFIG) -> tuple[list[Program], int]:
+                cfg: VCCConfig = DEFAULT_CONFIG, graded: bool = False) -> tuple[list[Program], int]:
     """(first parts, most progress first then most probable; complete programs judged):
     programs that bring the pairs closer to their outputs (`ProgressBackend`), one per
     distinct effect on the pairs (two that make the same scenes leave the same rest)."""
@@ -108,14 +133,14 @@ def first_parts(chain: Chain, pairs: Sequence[tuple[Scene, Scene]], settings: Pa
         made = outcomes(program_of(chain, [int(x) for x in path if x >= 0]), inputs, cfg)
         return tuple((None if m is None else (m.objects, m.pointer)) for m in made)
 
-    searcher = Searcher(ProgressBackend(cfg), width=1)
+    searcher = Searcher(ProgressBackend(cfg, graded), width=1)
     alternatives = Alternatives(int(math.ceil(settings.margin_nats / chain.delta)), settings.candidates,
                                 settings.budget, effect)
     r = searcher.search(chain, Task.from_pairs(pairs, cfg), settings.budget, alternatives=alternatives)
     if not r.found:
         return [], r.programs
     found = [r.program] + [a.program for a in r.alternatives]
-    order = sorted(range(len(found)), key=lambda i: (-progress(found[i], pairs, cfg), i))
+    order = sorted(range(len(found)), key=lambda i: (-progress(found[i], pairs, cfg, graded), i))
     return [found[i] for i in order][: settings.tries], r.programs
 
 
@@ -158,6 +183,7 @@ def learn_in_parts(pairs: Sequence[tuple[Scene, Scene]], chain_of: Callable[[Seq
     With `settings.rivals`, the search goes on past the first fit: the rests are searched
     with their own rivals, every first part is tried, and up to `rivals` other joins that
     fit every pair are kept, for the question back (few pairs fit many joins)."""
+    top = allowance is None  # continuations are searched at the top only
     allowance = allowance or _Allowance(settings.allowance)
     if settings.max_parts < 2 or not allowance.take(settings.budget):
         return None, 0
@@ -194,11 +220,43 @@ def learn_in_parts(pairs: Sequence[tuple[Scene, Scene]], chain_of: Callable[[Seq
             joined = next((j for j in joins(first, tail) if fits(j, pairs, cfg)), None)
             if joined is not None and all(joined != f[1] for f in fitting):
                 fitting.append((join_nats(whole, joined), joined, (first,) + tail_parts))
+    if not fitting and top and settings.continuations and allowance.take(settings.budget):
+        found, n = continued(whole, pairs, searcher, settings, allowance, cfg, log)
+        judged += n
+        fitting += found
     if not fitting:
         return None, judged
     fitting.sort(key=lambda f: f[0])  # stable: equal lengths keep the order found
     (_, program, parts), rest_fits = fitting[0], fitting[1:]
     return InParts(program, parts, tuple(f[1] for f in rest_fits[: settings.rivals])), judged
+
+
+def continued(whole: Chain, pairs: Sequence[tuple[Scene, Scene]], searcher: Searcher, settings: PartsSettings,
+              allowance: _Allowance, cfg: VCCConfig = DEFAULT_CONFIG, log: Callable[[str], None] | None = None
+              ) -> tuple[list[tuple[float, Program, tuple[Program, ...]]], int]:
+    """([(nats, program, (first part, what follows))] that fit every pair, complete
+    programs judged): first parts judged by graded progress (their search already
+    taken from `allowance`), each continued by a search of the programs that start with
+    it (`Searcher.search` with a prefix), on the whole pairs and their chain."""
+    firsts, judged = first_parts(whole, pairs, settings, cfg, graded=True)
+    task = Task.from_pairs(pairs, cfg)
+    fitting: list[tuple[float, Program, tuple[Program, ...]]] = []
+    for first in firsts:
+        spelt = whole.cheapest(first.ops, first.args)
+        if spelt is None or not allowance.take(settings.budget):
+            continue
+        if log:
+            log(f"first part {first.text()}: what follows, from the machine state it leaves")
+        alternatives = (Alternatives(int(math.ceil(settings.margin_nats / whole.delta)), settings.rivals,
+                                     settings.budget) if settings.rivals else None)
+        r = searcher.search(whole, task, settings.budget, alternatives=alternatives, prefix=spelt[1])
+        judged += r.programs
+        for p in ([r.program] + [a.program for a in r.alternatives]) if r.found else []:
+            if fits(p, pairs, cfg) and all(p != f[1] for f in fitting):
+                n = len(first.ops)  # the parts: the first, and what follows it (if anything)
+                parts = (first,) + ((Program(p.ops[n:], p.args[n:]),) if len(p) > n else ())
+                fitting.append((join_nats(whole, p), p, parts))
+    return fitting, judged
 
 
 def join_nats(chain: Chain, program: Program) -> float:

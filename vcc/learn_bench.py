@@ -34,8 +34,10 @@ STARTS = ("library", "uniform")
 # scenes may hold one object more than the examples; 3: what no whole program fits is
 # learned in parts (`search.parts`); 4: of the joins of parts that fit, the most probable,
 # and what the library's search misses is tried from a uniform start over a tenth of the
-# budget before the parts (`search.learn.from_uniform`) (a run of another protocol is refused)
-PROTOCOL = 4
+# budget before the parts (`search.learn.from_uniform`); 5: when no join of parts fits,
+# graded first parts continued from the machine state they leave (`search.parts.continued`)
+# (a run of another protocol is refused)
+PROTOCOL = 5
 # What every results line must hold (the key of `_key`, and whether it was found).
 RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 

@@ -135,19 +135,26 @@ def box_inside(x: int, y: int, w: int, cfg: VCCConfig) -> bool:
 def matching_size(a: Scene, b: Scene, tau: float) -> int:
     """How many objects of `a` can be paired one to one with objects of `b` of the same
     shape and color and a center within tau (a maximum bipartite matching)."""
-    ok = [
-        [
-            oa.shape == ob.shape
-            and oa.color == ob.color
-            and (oa.x - ob.x) ** 2 + (oa.y - ob.y) ** 2 <= tau * tau
-            for ob in b.objects
-        ]
-        for oa in a.objects
-    ]
-    match_b = [-1] * len(b.objects)
+    return _most_pairs([[oa.shape == ob.shape and oa.color == ob.color
+                         and (oa.x - ob.x) ** 2 + (oa.y - ob.y) ** 2 <= tau * tau for ob in b.objects]
+                        for oa in a.objects])
+
+
+def aligned_size(a: Scene, b: Scene, tau: float) -> int:
+    """As `matching_size`, with pairs whose centers need agree only in x or in y (within
+    tau): objects already in their row or column. At least `matching_size`."""
+    return _most_pairs([[oa.shape == ob.shape and oa.color == ob.color
+                         and min(abs(oa.x - ob.x), abs(oa.y - ob.y)) <= tau for ob in b.objects]
+                        for oa in a.objects])
+
+
+def _most_pairs(ok: list[list[bool]]) -> int:
+    """The size of a maximum matching of rows to columns where `ok` allows (augmenting paths)."""
+    n_b = len(ok[0]) if ok else 0
+    match_b = [-1] * n_b
 
     def augment(i: int, seen: list[bool]) -> bool:
-        for j in range(len(b.objects)):
+        for j in range(n_b):
             if ok[i][j] and not seen[j]:
                 seen[j] = True
                 if match_b[j] < 0 or augment(match_b[j], seen):
@@ -155,7 +162,7 @@ def matching_size(a: Scene, b: Scene, tau: float) -> int:
                     return True
         return False
 
-    return sum(augment(i, [False] * len(b.objects)) for i in range(len(a.objects)))
+    return sum(augment(i, [False] * n_b) for i in range(len(ok)))
 
 
 def scenes_match(a: Scene, b: Scene, tau: float) -> bool:
