@@ -255,7 +255,8 @@ def add_commands(sub) -> None:
                         "fit (default 2000000; 0: none)")
     p.add_argument("--parts", type=runtime.count(1, 5), default=3,
                    help="when no program fits within the budget, learn one in up to this many parts, each bringing "
-                        "the examples closer to their outputs (default 3; 1: never)")
+                        "the examples closer to their outputs, or continuing from where the first leaves the machine "
+                        "(default 3; 1: never)")
     p.add_argument("--fresh-scenes", type=runtime.count(1, 10**5), default=100,
                    help="scenes the rivals are compared on (default 100)")
     p.add_argument("--seed", type=runtime.count(0), default=0, help="seed of the fresh scenes (default 0)")
