@@ -52,6 +52,7 @@ class Settings:
     max_iterations: int = 8
     max_subroutines: int = 100
     delta: float = 0.01  # nats per cost bin
+    parts: int = 1  # after the iterations, missed concepts learned in up to this many parts (1: never)
 
     def __post_init__(self) -> None:
         if self.args not in ARG_MODES:
@@ -60,6 +61,8 @@ class Settings:
             raise ValueError(f"--order must be 0 or 1, got {self.order}")
         if self.budget < 1:
             raise ValueError("--budget must be positive")
+        if not 1 <= self.parts <= 3:
+            raise ValueError(f"--parts must be 1, 2 or 3, got {self.parts}")
 
 
 def needs_answer(settings: Settings) -> bool:
@@ -114,7 +117,7 @@ class Run:
         # leaves the folder as it was
         if meta.exists():
             info = self._meta()
-            if info.get("settings") != mine:
+            if not same_search(info.get("settings"), mine):
                 raise DataFileError(
                     f"{meta}: this folder holds a run with other settings {info.get('settings')}; "
                     "use another --out or the same settings to resume"
@@ -123,7 +126,8 @@ class Run:
             raise DataFileError(f"{self.out}: holds files but no run.json, so it is not a run to resume; "
                                 "use another --out")
         else:
-            info = {"format": "vccjax-induce", "version": 1, "settings": mine}
+            info = {"format": "vccjax-induce", "version": 1}
+        info["settings"] = mine  # a resume may add the parts pass
         self.records = read_records(self.results_path)
         drop_cut_tail(self.results_path)  # never a rewrite: a kill then would lose the run
         info.setdefault("sessions", []).append(round(time.time(), 3))  # starts, for the wall time
@@ -209,6 +213,15 @@ class Run:
         append_line(self.results_path, record)
 
 
+def same_search(recorded: object, mine: dict) -> bool:
+    """Whether a run folder's recorded settings search as `mine`: all alike but `parts`,
+    which only adds a pass after the iterations (a folder written before it existed
+    holds none), so a finished run may be resumed to add it."""
+    if not isinstance(recorded, dict):
+        return False
+    return {**recorded, "parts": 0} == {**mine, "parts": 0}
+
+
 def read_records(path: Path) -> list[dict]:
     """A results file's records; a last line cut by an interrupt is dropped (that concept
     is redone), any other bad line is an error."""
@@ -226,7 +239,7 @@ RECORD_SCHEMA: Schema = {
 }
 
 
-def _record(concept: str, it: int, r: Result, test: tuple[int, int] | None) -> dict:
+def record_of(concept: str, it: int, r: Result, test: tuple[int, int] | None) -> dict:
     return {
         "concept": concept, "found": r.found, "iteration": it,
         "program": r.program.text() if r.program else None, "compressed": r.text,
@@ -271,11 +284,7 @@ def induce(
             vocab, model = start or (Vocabulary(), MarkovModel.uniform(Vocabulary().size, settings.order))
         else:
             vocab, model = fit_model(programs, settings, subs_on)
-        files.write_json(run.out / f"model-{it}.json", {
-            "iteration": it, "order": settings.order, "subroutines": vocab.to_json(),
-            "tokens": [vocab.name(t) for t in range(vocab.size)] + ["<end>"],
-            "logp": np.round(model.logp, 6).tolist(),
-        }, indent=None)
+        write_model(run, it, settings, vocab, model)
         done = {r["concept"] for r in run.records if r["iteration"] == it} | set(before)
         todo = [c for c in concepts if c not in done]
         bar = tqdm(total=len(todo), desc=f"iteration {it}", disable=not progress, unit="concept")
@@ -286,7 +295,7 @@ def induce(
             if r.found:
                 tp = pairs(c, "test")
                 test = (generalization(r.program, tp, DEFAULT_CONFIG.tau), len(tp))
-            run.append({**_record(c, it, r, test), "subroutines": subs})
+            run.append({**record_of(c, it, r, test), "subroutines": subs})
             bar.update()
             bar.set_postfix(found=len(run.found()))
 
@@ -308,7 +317,20 @@ def induce(
                 subs_on = True  # the plain model saturated: compress from now on
                 continue
             break
+    if settings.parts > 1:
+        from search.parts_pass import parts_pass
+
+        parts_pass(run, concepts, pairs, settings, explorer, answers, start, progress, log)
     return run
+
+
+def write_model(run: Run, it: int, settings: Settings, vocab: Vocabulary, model: MarkovModel) -> None:
+    """`model-{it}.json`: the model iteration `it` searched with."""
+    files.write_json(run.out / f"model-{it}.json", {
+        "iteration": it, "order": settings.order, "subroutines": vocab.to_json(),
+        "tokens": [vocab.name(t) for t in range(vocab.size)] + ["<end>"],
+        "logp": np.round(model.logp, 6).tolist(),
+    }, indent=None)
 
 
 def model_sha256(vocab: Vocabulary, model: MarkovModel) -> str:
@@ -349,7 +371,10 @@ def summary(run: Run, concepts: Sequence[str]) -> dict:
         "programs_per_second": round(covered / secs) if secs else None,
         "programs_run_per_second": round(sum(r["programs_run"] for r in recs) / secs) if secs else None,
         # what the same run with subroutines off finds: it stops where this one turns them on
-        "found_without_subroutines": sum(1 for r in found.values() if not r.get("subroutines")),
+        "found_without_subroutines": sum(1 for r in found.values()
+                                         if not r.get("subroutines") and not r.get("parts")),
+        # the pass after the iterations (`search.parts_pass`): concepts learned in parts
+        "found_in_parts": sum(1 for r in found.values() if r.get("parts")),
         "per_iteration": {
             it: sum(1 for r in recs if r["iteration"] == it and r["found"])
             for it in sorted({r["iteration"] for r in recs})

@@ -1,0 +1,82 @@
+"""Explore-compress's pass over the concepts it missed, learned in parts
+(`search.parts_pass`): what it adds, that a finished run resumed gains it without
+redoing anything, and what a resume still refuses."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from search.induce import Settings, induce, read_records, summary
+from search.scalar import ScalarExplorer
+from vcc.cli import main
+from vccjax.errors import DataFileError
+from vccjax.machine.config import DEFAULT_CONFIG
+from vccjax.machine.program import parse
+from vccjax.machine.reference import RefMachine
+from vccjax.machine.scene import scenes_match
+from vccjax.world.dataset import Dataset
+
+TWO_PARTS = ("scene_parse; fixate(top); top_down_attend; fill_color(red); reset_attn; "
+             "fixate(bottom); top_down_attend; fill_color(blue)")
+PROGRAMS = f"""# a two-part concept whose whole program lies past a small budget, and a short one
+recolor_top_red_and_bottom_blue: {TWO_PARTS}
+recolor_bottom_obj_blue: scene_parse; fixate(bottom); top_down_attend; fill_color(blue)
+"""
+BUDGET = 20_000
+
+
+@pytest.fixture(scope="module")
+def ds(tmp_path_factory):
+    root = tmp_path_factory.mktemp("parts_pass")
+    (root / "programs.txt").write_text(PROGRAMS)
+    assert main(["dataset", "build", "--programs", str(root / "programs.txt"), "--out", str(root / "ds"),
+                 "--workers", "1"]) == 0
+    return Dataset(root / "ds")
+
+
+def _induce(ds, out, parts: int, **kw):
+    return induce(ds.concepts, ds.pairs, out, Settings(budget=BUDGET, args="oracle", max_iterations=1, parts=parts,
+                                                       **kw),
+                  explorer=ScalarExplorer(width=1), progress=False, answers=ds.program, log=lambda _: None)
+
+
+def test_a_finished_run_resumed_with_parts_learns_what_it_missed(ds, tmp_path):
+    out = tmp_path / "run"
+    run = _induce(ds, out, parts=1)
+    assert set(run.found()) == {"recolor_bottom_obj_blue"}  # the whole two-part program: past the budget
+    before = (out / "results.jsonl").read_text()
+
+    run = _induce(ds, out, parts=2)
+    assert (out / "results.jsonl").read_text().startswith(before)  # nothing redone, nothing rewritten
+    rec = run.found()["recolor_top_red_and_bottom_blue"]
+    assert rec["parts"] == 2 and rec["iteration"] == 1  # the pass's number: past every iteration's
+    program = parse(rec["program"])
+    for a, b in ds.pairs("recolor_top_red_and_bottom_blue", "train"):  # checked like any found program
+        m = RefMachine(a).run(program)
+        assert not m.failed and scenes_match(m.output_scene(), b, DEFAULT_CONFIG.tau)
+    assert rec["test_correct"] == rec["test_total"] == len(ds.pairs("recolor_top_red_and_bottom_blue", "test"))
+    s = summary(run, ds.concepts)
+    assert s["found"] == 2 and s["found_in_parts"] == 1 and s["per_iteration"] == {0: 1, 1: 1}
+    assert (out / "model-1.json").exists()  # the model the pass searched with
+    assert json.loads((out / "run.json").read_text())["settings"]["parts"] == 2
+
+    lines = len(read_records(out / "results.jsonl"))
+    _induce(ds, out, parts=2)  # resumed again: the pass is not repeated
+    assert len(read_records(out / "results.jsonl")) == lines
+
+
+def test_a_resume_with_other_search_settings_is_still_refused(ds, tmp_path):
+    out = tmp_path / "run"
+    _induce(ds, out, parts=1)
+    with pytest.raises(DataFileError, match="other settings"):
+        _induce(ds, out, parts=2, epsilon=0.2)
+
+
+@pytest.mark.parametrize("value", ["0", "4", "two"])
+def test_a_bad_parts_value_is_one_line(tmp_path, capsys, value):
+    assert main(["induce", "--concepts", "demo", "--out", str(tmp_path / "r"), "--parts", value]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--parts" in err[0]
+    assert not (tmp_path / "r").exists()
