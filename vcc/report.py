@@ -79,7 +79,14 @@ def _cell(s: dict | None) -> str:
     if s is None:
         return "not run"
     part = "" if s.get("complete") else " (partial: run interrupted, resumable)"
-    return f"{s['found']} of {s['concepts']}{part}"
+    parts = s.get("found_in_parts", 0)
+    pass_ = f" ({s['found'] - parts} before the pass in parts, which learned {parts})" if parts else ""
+    return f"{s['found']} of {s['concepts']}{pass_}{part}"
+
+
+def _pass(settings: dict) -> str:
+    """The pass in parts after the iterations, where a run's settings have one."""
+    return f", then in up to {settings['parts']} parts" if settings.get("parts", 1) > 1 else ""
 
 
 def _weights(s: dict | None) -> str:
@@ -176,7 +183,7 @@ def other_runs_section(folder: Path) -> list[str]:
         if s is None:
             continue
         lines.append(f"| `{path}` | order {st.get('order')}, {st.get('args')} arguments, budget {st.get('budget'):,}, "
-                     f"subroutines {'on' if st.get('subroutines') else 'off'}{_weights(s)} | {_cell(s)} | "
+                     f"subroutines {'on' if st.get('subroutines') else 'off'}{_pass(st)}{_weights(s)} | {_cell(s)} | "
                      f"{s['found_without_subroutines']} | {s['exact_on_all_test_pairs']} | "
                      f"{s['wall_seconds'] / 60:.0f} min | {s['programs_per_second']:,} "
                      f"({s['programs_run_per_second']:,}) |")
