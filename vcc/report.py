@@ -294,6 +294,27 @@ def learn_section(results: list[tuple[str, dict]]) -> list[str]:
     return lines + [""]
 
 
+def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
+    """The argument predictor's recall and sharpness (`vcc argpred eval`): concepts whose
+    used arguments all pass the threshold, and the arguments passed that a concept never
+    uses, per function (each widens the search)."""
+    runs = _latest(results, "argpred-recall")
+    if not runs:
+        return []
+    lines = ["## Argument predictor: recall and extra arguments (`vcc argpred eval`)", "",
+             "| file | weights | concepts (split) | recalled: every used argument passes | "
+             "mean extra arguments per concept, by function | not recalled |", "|---|---|---|---|---|---|"]
+    for name, d in runs:
+        n = d["concepts"] if isinstance(d["concepts"], int) else len(d["concepts"])
+        extra = ", ".join(f"{f} {v:.2f}" for f, v in d["mean_extra_arguments"].items())
+        missed = "; ".join(f"{c}: " + ", ".join(f"{f}({', '.join(v)})" for f, v in fs.items())
+                           for c, fs in d["missed"].items()) or "none"
+        lines.append(f"| `{name}` | {d['weights']} `{d['weights_sha256'][:8]}` ({d['members']} networks) | "
+                     f"{n} ({d['split']}) | {d['recalled']} ({d['recall']:.1%}) | {extra} | {missed} |")
+    return lines + [""] + [f"- `{n}`: {d.get('date', '?')}, commit {d.get('commit', '?')}; command "
+                           f"`{d.get('command', '?')}`" for n, d in runs] + [""]
+
+
 def collect_rows(runs: Path) -> dict[str, dict]:
     """Every row folder under `runs` that holds a run, by folder name."""
     out = {}
@@ -329,6 +350,7 @@ def render(results_dir: Path, rows: dict[str, dict], stamp: dict, others: Path |
                             (lambda: stress_section(robot) if robot else [], robot),
                             (lambda: camera_section(results), results_dir),
                             (lambda: learn_section(results), results_dir),
+                            (lambda: argpred_section(results), results_dir),
                             (lambda: cluster_section(results), results_dir)):
         try:
             lines += section()

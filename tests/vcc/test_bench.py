@@ -260,6 +260,29 @@ def test_the_report_gives_the_learning_benchmark_and_vcc_learns_wall_time():
     assert "`new.json`" in text and learn_section([]) == []
 
 
+def test_the_report_gives_the_predictors_recall_and_extra_arguments():
+    from vcc.report import argpred_section
+
+    d = {"benchmark": "argpred-recall", "date": "2031-01-01", "commit": "abc", "command": "vcc argpred eval",
+         "weights": "shipped", "weights_sha256": "0123456789ab", "members": 3, "split": "train", "concepts": 8,
+         "recalled": 6, "recall": 6 / 8, "mean_extra_arguments": {"set_shape_attn": 0.5, "fill_color": 1.25},
+         "missed": {"c1": {"fill_color": ["red", "blue"]}}}
+    lines = argpred_section([("argpred-recall.json", d)])
+    row = next(x for x in lines if x.startswith("| `argpred-recall.json`"))
+    assert f"| 6 ({6 / 8:.1%}) |" in row and "set_shape_attn 0.50, fill_color 1.25" in row
+    assert "c1: fill_color(red, blue)" in row and "`01234567`" in row
+    assert argpred_section([]) == []
+
+
+def test_a_run_with_the_pass_in_parts_reads_with_and_without_it():
+    from vcc.report import _cell, _pass
+
+    s = {"complete": True, "found": 12, "concepts": 20, "found_in_parts": 3}
+    assert _cell(s) == "12 of 20 (9 before the pass in parts, which learned 3)"
+    assert _cell({**s, "found_in_parts": 0}) == "12 of 20"
+    assert _pass({"parts": 2}) == ", then in up to 2 parts" and _pass({}) == ""
+
+
 def test_bench_emulator_cuts_batches_as_the_search_does():
     """Each instruction's children go in the search's padded sizes (its cheapest cover,
     capped at the bench's batch), every child once; a carry op's holding rows apart when
