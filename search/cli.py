@@ -63,8 +63,8 @@ def cmd_induce(a: argparse.Namespace) -> int:
     for it, k in s["per_iteration"].items():
         print(f"{'  new in iteration ' + str(it):<28}{k}")
     print(f"{'  without subroutines':<28}{s['found_without_subroutines']}")
-    if s["found_in_parts"]:
-        print(f"{'  learned in parts':<28}{s['found_in_parts']} (the pass after the iterations)")
+    if s["found_in_last_pass"]:
+        print(f"{'  new in the last pass':<28}{s['found_in_last_pass']} ({s['found_in_parts']} of them in parts)")
     print(f"{'wall time (s)':<28}{s['wall_seconds']:.1f} (all sessions of this run)")
     print(f"{'search time (s)':<28}{s['search_seconds']:.1f} (+{s['compile_seconds']:.1f} compiling)")
     print(f"{'programs searched':<28}{s['programs_covered']} ({s['programs_run']} run, rest pruned)")
@@ -132,10 +132,11 @@ def add_commands(sub) -> None:
     p.add_argument("--epsilon", type=runtime.number(0, 1), default=0.1, help="pseudocount (default 0.1)")
     p.add_argument("--iterations", type=runtime.count(1, 100), default=8, help="explore-compress iterations at most")
     p.add_argument("--parts", type=runtime.count(1, 3), default=1,
-                   help="after the iterations, each concept still missed learned in up to this many parts "
-                        "(a first part that brings every example closer, then the rest; each part a tenth of "
-                        "the budget, all at most the budget again; docs/search.md); 1 (default): never. "
-                        "A finished run resumed with --parts 2 or 3 adds this pass")
+                   help="2 or 3: after the iterations, a last pass over the concepts still missed, each "
+                        "searched whole with the model of everything found and, where that fails, in up to "
+                        "this many parts (each part a tenth of the budget, all at most the budget again; "
+                        "docs/search.md); 1 (default): no such pass. A finished run resumed with --parts 2 "
+                        "or 3 adds it")
     p.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax, seed 0)")
     p.add_argument("--seed", type=runtime.count(0), default=0,
                    help="examples' seed without --dataset: 0 (default) is the shipped dataset; another "

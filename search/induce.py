@@ -52,7 +52,7 @@ class Settings:
     max_iterations: int = 8
     max_subroutines: int = 100
     delta: float = 0.01  # nats per cost bin
-    parts: int = 1  # after the iterations, missed concepts learned in up to this many parts (1: never)
+    parts: int = 1  # >= 2: a last pass over missed concepts, whole then in up to this many parts (1: none)
 
     def __post_init__(self) -> None:
         if self.args not in ARG_MODES:
@@ -373,7 +373,8 @@ def summary(run: Run, concepts: Sequence[str]) -> dict:
         # what the same run with subroutines off finds: it stops where this one turns them on
         "found_without_subroutines": sum(1 for r in found.values()
                                          if not r.get("subroutines") and not r.get("parts")),
-        # the pass after the iterations (`search.parts_pass`): concepts learned in parts
+        # the last pass after the iterations (`search.parts_pass`): found there, and in parts
+        "found_in_last_pass": sum(1 for r in found.values() if r.get("last_pass")),
         "found_in_parts": sum(1 for r in found.values() if r.get("parts")),
         "per_iteration": {
             it: sum(1 for r in recs if r["iteration"] == it and r["found"])

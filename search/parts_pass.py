@@ -1,21 +1,26 @@
-"""Explore-compress's last pass: each concept it missed, learned in parts with the model
-of everything it found.
+"""Explore-compress's last pass: each concept it missed, searched once more with the model
+of everything it found, whole and then in parts, as `vcc learn` learns a new concept.
 
-Many concepts the whole search misses are two learned ones joined ("move all yellow
-objects down, and all green ones up"): the joined program ranks far past the budget,
-while each half, under a model fitted on the programs found, is among the first few
-thousand. After the iterations end, this pass tries every concept still missed with
-`search.parts.learn_in_parts` (a first part that brings every example closer to its
-output, then the rest from what it makes, the join checked on every pair by the
-reference machine), each part's search a tenth of the budget and all of them together
-at most the budget again: one more iteration's worth of search per missed concept.
+The iterations stop at `max_iterations` or when one finds nothing new; the programs its
+last iteration found never guided a search, and a model fitted on them may already rank
+a missed concept within the budget: the pass first searches the missed concepts whole,
+in lockstep, as an iteration does. Many that stay missed are two learned concepts
+joined ("move all yellow objects down, and all green ones up"): the joined program
+ranks far past the budget, while each half, under that model, is among the first few
+thousand. Those are then tried with `search.parts.learn_in_parts` (a first part that
+brings every example closer to its output, the rest from what it makes, the join
+checked on every pair by the reference machine), each part's search a tenth of the
+budget and all of them together at most the budget again. So the pass costs at most
+two budgets per missed concept.
 
-Its records carry the iteration number `max_iterations` (past every iteration's) and
-`parts` (how many); a resume skips the concepts it has already tried.
+Its records carry the iteration number `max_iterations` (past every iteration's),
+`last_pass` and `parts` (how many; 0 when found whole); a resume skips the concepts it
+has already recorded.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Sequence
 
@@ -26,6 +31,7 @@ from search.induce import (Run, Settings, argument_logp, fit_model, generalizati
 from search.model import MarkovModel, Vocabulary
 from search.parts import PartsSettings, join_nats, learn_in_parts
 from search.result import Result, text_of
+from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.machine.program import Program, parse
 from vccjax.machine.scene import Scene
@@ -48,29 +54,48 @@ def parts_pass(run: Run, concepts: Sequence[str], pairs: Callable[[str, str], Pa
                                       settings.subroutines)
     write_model(run, it, settings, vocab, model)
     missed = [c for c in dict.fromkeys(concepts) if c not in found and c not in run.tried(it)]
-    if not isinstance(searcher, Searcher):  # a cluster searches many concepts at once, not one
-        searcher = Explorer(width=1)
-
     def chain_of(c: str, p: Pairs) -> Chain:
         answer = answers(c) if answers is not None and needs_answer(settings) else None
         return Chain(vocab, model, argument_logp(settings, c, p, answer), settings.delta)
 
-    bar = tqdm(total=len(missed), desc="in parts", disable=not progress, unit="concept")
+    bar = tqdm(total=len(missed), desc="last pass", disable=not progress, unit="concept")
 
-    def done(c: str, r: Result, parts: int) -> None:
+    def done(c: str, r: Result, parts: int, covered: int) -> None:
         test = None
         if r.found:
             tp = pairs(c, "test")
             test = (generalization(r.program, tp, DEFAULT_CONFIG.tau), len(tp))
-        run.append({**record_of(c, it, r, test), "covered": r.programs, "parts": parts,
+        run.append({**record_of(c, it, r, test), "covered": covered, "parts": parts, "last_pass": True,
                     "subroutines": len(vocab.bodies)})
         bar.update()
         bar.set_postfix(found=len(run.found()))
 
-    learn_missed(missed, lambda c: pairs(c, "train"), chain_of, searcher, settings.budget, settings.parts, done)
+    # whole first, all together in lockstep (as an iteration searches): the model of
+    # everything found may already rank a missed concept within the budget
+    jobs = [(chain_of(c, pairs(c, "train")), Task.from_pairs(pairs(c, "train"))) for c in missed]
+    whole: dict[str, Result] = {}
+
+    def whole_done(j: int, r: Result) -> None:
+        whole[missed[j]] = r
+        if r.found:
+            done(missed[j], r, 0, r.rank)
+
+    if jobs:
+        searcher.search_many(jobs, settings.budget, whole_done)
+    if not isinstance(searcher, Searcher):  # a cluster searches many concepts at once, not one by one
+        searcher = Explorer(width=1)
+    rest = [c for c in missed if not whole[c].found]
+
+    def parts_done(c: str, r: Result, parts: int) -> None:
+        w = whole[c]
+        done(c, dataclasses.replace(r, programs=w.programs + r.programs, seconds=w.seconds + r.seconds,
+                                    compile_seconds=w.compile_seconds), parts, w.budget + r.programs)
+
+    learn_missed(rest, lambda c: pairs(c, "train"), chain_of, searcher, settings.budget, settings.parts, parts_done)
     bar.close()
-    new = sum(1 for r in run.records if r["iteration"] == it and r["found"])
-    log(f"in parts: {new} new, {len(run.found())} of {len(set(concepts))} found")
+    new = [r for r in run.records if r["iteration"] == it and r["found"]]
+    log(f"last pass: {len(new)} new ({sum(1 for r in new if r['parts'])} in parts), "
+        f"{len(run.found())} of {len(set(concepts))} found")
 
 
 def parts_settings(budget: int, max_parts: int) -> PartsSettings:

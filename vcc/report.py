@@ -79,14 +79,16 @@ def _cell(s: dict | None) -> str:
     if s is None:
         return "not run"
     part = "" if s.get("complete") else " (partial: run interrupted, resumable)"
-    parts = s.get("found_in_parts", 0)
-    pass_ = f" ({s['found'] - parts} before the pass in parts, which learned {parts})" if parts else ""
+    last = s.get("found_in_last_pass", 0)
+    pass_ = (f" ({s['found'] - last} before the last pass, which found {last}, "
+             f"{s.get('found_in_parts', 0)} of them in parts)" if last else "")
     return f"{s['found']} of {s['concepts']}{pass_}{part}"
 
 
 def _pass(settings: dict) -> str:
-    """The pass in parts after the iterations, where a run's settings have one."""
-    return f", then in up to {settings['parts']} parts" if settings.get("parts", 1) > 1 else ""
+    """The last pass after the iterations, where a run's settings have one."""
+    return (f", then a last pass (whole, then in up to {settings['parts']} parts)"
+            if settings.get("parts", 1) > 1 else "")
 
 
 def _weights(s: dict | None) -> str:

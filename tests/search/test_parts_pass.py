@@ -20,9 +20,10 @@ from vccjax.world.dataset import Dataset
 
 TWO_PARTS = ("scene_parse; fixate(top); top_down_attend; fill_color(red); reset_attn; "
              "fixate(bottom); top_down_attend; fill_color(blue)")
-PROGRAMS = f"""# a two-part concept whose whole program lies past a small budget, and a short one
+PROGRAMS = f"""# a two-part concept whose whole program lies past a small budget, and two short ones
 recolor_top_red_and_bottom_blue: {TWO_PARTS}
 recolor_bottom_obj_blue: scene_parse; fixate(bottom); top_down_attend; fill_color(blue)
+recolor_top_obj_red: scene_parse; fixate(top); top_down_attend; fill_color(red)
 """
 BUDGET = 20_000
 
@@ -36,8 +37,8 @@ def ds(tmp_path_factory):
     return Dataset(root / "ds")
 
 
-def _induce(ds, out, parts: int, **kw):
-    return induce(ds.concepts, ds.pairs, out, Settings(budget=BUDGET, args="oracle", max_iterations=1, parts=parts,
+def _induce(ds, out, parts: int, concepts=("recolor_top_red_and_bottom_blue", "recolor_bottom_obj_blue"), **kw):
+    return induce(list(concepts), ds.pairs, out, Settings(budget=BUDGET, args="oracle", max_iterations=1, parts=parts,
                                                        **kw),
                   explorer=ScalarExplorer(width=1), progress=False, answers=ds.program, log=lambda _: None)
 
@@ -57,14 +58,33 @@ def test_a_finished_run_resumed_with_parts_learns_what_it_missed(ds, tmp_path):
         m = RefMachine(a).run(program)
         assert not m.failed and scenes_match(m.output_scene(), b, DEFAULT_CONFIG.tau)
     assert rec["test_correct"] == rec["test_total"] == len(ds.pairs("recolor_top_red_and_bottom_blue", "test"))
-    s = summary(run, ds.concepts)
-    assert s["found"] == 2 and s["found_in_parts"] == 1 and s["per_iteration"] == {0: 1, 1: 1}
+    s = summary(run, list(run.found()))
+    assert s["found"] == 2 and s["found_in_parts"] == s["found_in_last_pass"] == 1
+    assert s["per_iteration"] == {0: 1, 1: 1}
     assert (out / "model-1.json").exists()  # the model the pass searched with
     assert json.loads((out / "run.json").read_text())["settings"]["parts"] == 2
 
     lines = len(read_records(out / "results.jsonl"))
     _induce(ds, out, parts=2)  # resumed again: the pass is not repeated
     assert len(read_records(out / "results.jsonl")) == lines
+
+
+def test_the_last_pass_searches_whole_first_with_the_model_of_what_was_found(ds, tmp_path):
+    """A concept the iterations missed that the model fitted on everything found ranks
+    within the budget is found whole (no parts) by the pass, as one more iteration would.
+    The run is made to have missed it: its iteration-0 record says so."""
+    out = tmp_path / "run"
+    _induce(ds, out, parts=1, concepts=["recolor_bottom_obj_blue"])
+    from vccjax.records import append_line
+
+    append_line(out / "results.jsonl", {"concept": "recolor_top_obj_red", "found": False, "iteration": 0,
+                                        "program": None, "dl": None, "covered": BUDGET, "seconds": 0.0,
+                                        "nodes": 0, "programs_run": 0, "test_correct": None, "test_total": None})
+    run = _induce(ds, out, parts=2, concepts=["recolor_bottom_obj_blue", "recolor_top_obj_red"])
+    rec = run.found()["recolor_top_obj_red"]
+    assert rec["last_pass"] and rec["parts"] == 0 and rec["iteration"] == 1
+    assert rec["program"] == "scene_parse; fixate(top); top_down_attend; fill_color(red)"
+    assert rec["rank"] <= BUDGET and rec["covered"] == rec["rank"]
 
 
 def test_a_resume_with_other_search_settings_is_still_refused(ds, tmp_path):

@@ -274,13 +274,13 @@ def test_the_report_gives_the_predictors_recall_and_extra_arguments():
     assert argpred_section([]) == []
 
 
-def test_a_run_with_the_pass_in_parts_reads_with_and_without_it():
+def test_a_run_with_the_last_pass_reads_with_and_without_it():
     from vcc.report import _cell, _pass
 
-    s = {"complete": True, "found": 12, "concepts": 20, "found_in_parts": 3}
-    assert _cell(s) == "12 of 20 (9 before the pass in parts, which learned 3)"
-    assert _cell({**s, "found_in_parts": 0}) == "12 of 20"
-    assert _pass({"parts": 2}) == ", then in up to 2 parts" and _pass({}) == ""
+    s = {"complete": True, "found": 12, "concepts": 20, "found_in_last_pass": 3, "found_in_parts": 2}
+    assert _cell(s) == "12 of 20 (9 before the last pass, which found 3, 2 of them in parts)"
+    assert _cell({**s, "found_in_last_pass": 0}) == "12 of 20"
+    assert _pass({"parts": 2}) == ", then a last pass (whole, then in up to 2 parts)" and _pass({}) == ""
 
 
 def test_bench_emulator_cuts_batches_as_the_search_does():
