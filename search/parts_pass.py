@@ -54,6 +54,7 @@ def parts_pass(run: Run, concepts: Sequence[str], pairs: Callable[[str, str], Pa
                                       settings.subroutines)
     write_model(run, it, settings, vocab, model)
     missed = [c for c in dict.fromkeys(concepts) if c not in found and c not in run.tried(it)]
+
     def chain_of(c: str, p: Pairs) -> Chain:
         answer = answers(c) if answers is not None and needs_answer(settings) else None
         return Chain(vocab, model, argument_logp(settings, c, p, answer), settings.delta)
