@@ -372,7 +372,7 @@ def summary(run: Run, concepts: Sequence[str]) -> dict:
         "programs_run_per_second": round(sum(r["programs_run"] for r in recs) / secs) if secs else None,
         # what the same run with subroutines off finds: it stops where this one turns them on
         "found_without_subroutines": sum(1 for r in found.values()
-                                         if not r.get("subroutines") and not r.get("parts")),
+                                         if not r.get("subroutines") and not r.get("last_pass")),
         # the last pass after the iterations (`search.parts_pass`): found there, and in parts
         "found_in_last_pass": sum(1 for r in found.values() if r.get("last_pass")),
         "found_in_parts": sum(1 for r in found.values() if r.get("parts")),

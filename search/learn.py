@@ -27,7 +27,7 @@ from search.dfs import Alternatives
 from search.explore import Searcher
 from search.model import MarkovModel, Vocabulary
 from search.parts import PartsSettings, learn_in_parts
-from search.result import Alternative, Result, program_of, text_of
+from search.result import Alternative, Result, program_of, rank_of, text_of
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.machine.program import Program
@@ -201,10 +201,8 @@ def settle(searched: Result, chain: Chain, pairs: Sequence[tuple[Scene, Scene]],
         return searched
     nats, portions = best
     bins = chain.program_bins(portions)
-    counts = chain.count_table(budget=2**62, max_bins=bins)
-    rank = int(counts[bins - 1]) + 1 if bins > 0 else 1
     return dataclasses.replace(searched, found=True, program=program_of(chain, portions),
-                               text=text_of(chain, portions), dl_nats=nats, dl_bins=bins, rank=rank)
+                               text=text_of(chain, portions), dl_nats=nats, dl_bins=bins, rank=rank_of(chain, bins))
 
 
 def from_uniform(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings,
@@ -259,7 +257,7 @@ def in_parts(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: L
     if chain is None:  # broken syntax cannot come out of joined parts; kept as a guard
         return searched, ()
     bins = chain.program_bins(portions)
-    rank = int(chain.count_table(budget=2**62, max_bins=bins)[bins - 1]) + 1 if bins > 0 else 1
+    rank = rank_of(chain, bins)
     rivals = tuple(Alternative(p, text_of(c, z), n) for p in got.rivals
                    for c, n, z in [_spelt(p, pairs, settings, start)] if c is not None)
     return dataclasses.replace(searched, found=True, program=got.program, text=text_of(chain, portions),

@@ -29,8 +29,8 @@ from search.explore import Explorer, Searcher
 from search.induce import (Run, Settings, argument_logp, fit_model, generalization, needs_answer, record_of,
                            write_model)
 from search.model import MarkovModel, Vocabulary
-from search.parts import PartsSettings, join_nats, learn_in_parts
-from search.result import Result, text_of
+from search.parts import PartsSettings, learn_in_parts
+from search.result import Result, rank_of, text_of
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.machine.program import Program, parse
@@ -73,7 +73,7 @@ def parts_pass(run: Run, concepts: Sequence[str], pairs: Callable[[str, str], Pa
 
     # whole first, all together in lockstep (as an iteration searches): the model of
     # everything found may already rank a missed concept within the budget
-    jobs = [(chain_of(c, pairs(c, "train")), Task.from_pairs(pairs(c, "train"))) for c in missed]
+    jobs = [(chain_of(c, train), Task.from_pairs(train)) for c in missed for train in [pairs(c, "train")]]
     whole: dict[str, Result] = {}
 
     def whole_done(j: int, r: Result) -> None:
@@ -132,13 +132,11 @@ def _learned(chain: Chain, program: Program, budget: int, judged: int, seconds: 
     cheapest spelling under the whole pairs' chain (None where that chain cannot spell an
     argument a part's own pairs believed in)."""
     spelt = chain.cheapest(program.ops, program.args)
-    nats = join_nats(chain, program)
-    text, bins, rank = program.text(), None, None
-    if spelt is not None:
-        portions = spelt[1]
-        text = text_of(chain, portions)
-        bins = chain.program_bins(portions)
-        rank = int(chain.count_table(budget=2**62, max_bins=bins)[bins - 1]) + 1 if bins > 0 else 1
-    return Result(found=True, program=program, text=text, dl_nats=None if spelt is None else nats, dl_bins=bins,
-                  rank=rank, nodes=0, programs=judged, seconds=seconds, cutoff_bins=0, budget=budget)
-
+    if spelt is None:
+        return Result(found=True, program=program, text=program.text(), dl_nats=None, dl_bins=None, rank=None,
+                      nodes=0, programs=judged, seconds=seconds, cutoff_bins=0, budget=budget)
+    nats, portions = spelt
+    bins = chain.program_bins(portions)
+    return Result(found=True, program=program, text=text_of(chain, portions), dl_nats=float(nats), dl_bins=bins,
+                  rank=rank_of(chain, bins), nodes=0, programs=judged, seconds=seconds, cutoff_bins=0,
+                  budget=budget)

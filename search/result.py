@@ -67,6 +67,12 @@ def result_of(chain: Chain, budget: int, outcome: Outcome, seconds: float, compi
                   tuple(others))
 
 
+def rank_of(chain: Chain, bins: int) -> int:
+    """The rank of a program of `bins` cost bins under `chain`: the programs strictly
+    more probable, all of them counted however far past any budget, + 1."""
+    return int(chain.count_table(budget=2**62, max_bins=bins)[bins - 1]) + 1 if bins > 0 else 1
+
+
 def program_of(chain: Chain, portions: Sequence[int]) -> Program:
     """The atoms of a path of portions (subroutine calls expanded)."""
     ops = tuple(op for portion in portions for op in chain.ops[portion])
