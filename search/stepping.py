@@ -49,13 +49,14 @@ def holding_split(op: int, rows: np.ndarray, holding: np.ndarray,
     return [part for part in (rows[holding], rows[~holding]) if len(part)]
 
 
-def _batched(cfg: VCCConfig, op: int, make, first, states, *rest):
+def _batched(cfg: VCCConfig, op: int, make, first, states, *rest, stepped=True):
     """`make(fn)` builds the batched step `(first, states, *rest) -> states` with `fn`
     standing in for the op's function; a carry op pays for the carry only when some
-    state in the batch holds an object."""
+    state it steps (`stepped`, a mask like `states.hand.held`, or all) holds an object."""
     if op not in EMPTY_HANDED:
         return make(None)(first, states, *rest)
-    return jax.lax.cond(jnp.any(states.hand.held >= 0), make(None), make(EMPTY_HANDED[op]), first, states, *rest)
+    holding = (states.hand.held >= 0) & stepped
+    return jax.lax.cond(jnp.any(holding), make(None), make(EMPTY_HANDED[op]), first, states, *rest)
 
 
 def _per_task(consts: SceneConst, one, example_axes: tuple):
@@ -110,51 +111,71 @@ def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Arra
 
         return _per_task(consts, one, (None, None, 0))
 
-    return _batched(cfg, op, per_program, tasks, states, args, pcs, active)
+    return _batched(cfg, op, per_program, tasks, states, args, pcs, active, stepped=active & ~states.control.failed)
 
 
 BODY_OPS = OP["loop_start"]  # ops 0 .. BODY_OPS - 1 may be recorded in a loop body (docs/vcc.md section 5)
 
 
+REPLAY_CHUNK = 4  # rows a replayed instruction runs on at a time
+_CARRIES = np.array([op in EMPTY_HANDED for op in range(BODY_OPS)])  # body ops whose cost is the carry
+
+
 @functools.partial(jax.jit, static_argnums=0)
 def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState) -> VCCState:
     """Every further iteration of the loops just closed in (B, E) states (a `loop_end`
-    stepped with replay=False), in one device call. Per iteration (while
-    `loop_needs_iteration` holds for some row) and per body position, each instruction
-    that some row has there runs by a switch on an unbatched index, so only its code
-    runs, for the rows that have it (`replay_examples`): the host's replay of one call
-    per (iteration, position, instruction), without the host round trips."""
+    stepped with replay=False), in one device call: the host's replay of one call per
+    (iteration, position, instruction), without the host round trips.
+
+    Per iteration (while `loop_needs_iteration` holds for some row) and per body
+    position, the rows that run there are taken `REPLAY_CHUNK` at a time, rows of one
+    instruction together (of a carry op, rows that hold an object apart from those that
+    do not), gathered and run by a switch on an unbatched index (`replay_examples`), so
+    only that instruction's code runs, only for those rows: the cost follows the rows
+    still looping, not the batch. A program that failed on some example is dead (the
+    search drops it): none of its examples runs further."""
     ctl = states.control
     ops, args = ctl.body_ops[:, 0], ctl.body_args[:, 0]  # (B, L): a body is the same on every example
     length, pc0 = ctl.body_len[:, 0], ctl.body_pc0[:, 0]
+    rows, size = ops.shape[0], min(REPLAY_CHUNK, ops.shape[0])
+    carries = jnp.asarray(_CARRIES)
 
     def branch(op):
-        def run(s, j, here, active):
-            return replay_examples(cfg, op, consts, tasks, s, args[:, j], pc0 + j, active & here[:, None])
+        def run(s, at, j, active):
+            return replay_examples(cfg, op, consts, tasks[at], s, args[at, j], pc0[at] + j, active)
         return run
 
     branches = [branch(op) for op in range(BODY_OPS)]
 
+    def alive(s, it):
+        return loop_needs_iteration(cfg, s, it) & ~jnp.any(s.control.failed, axis=1, keepdims=True)
+
     def iterate(carry):
         it, s = carry
-        active = loop_needs_iteration(cfg, s, it)  # (B, E), fixed for this iteration
+        active = alive(s, it)  # (B, E), fixed for this iteration
         live_rows = active.any(axis=1)
 
         def position(j, s):
-            live = live_rows & (length > j)
+            op_here = jnp.minimum(ops[:, j], BODY_OPS - 1)
+            holds = jnp.any((s.hand.held >= 0) & active, axis=1)
+            key = 2 * op_here + (holds & carries[op_here])
 
-            def one_op(k, s):
-                here = live & (ops[:, j] == k)
-                return jax.lax.cond(here.any(), lambda s: jax.lax.switch(k, branches, s, j, here, active),
-                                    lambda s: s, s)
+            def chunk(carry):  # up to `size` pending rows of the least key
+                s, pending = carry
+                k = jnp.min(jnp.where(pending, key, 2 * BODY_OPS))
+                at = jnp.nonzero(pending & (key == k), size=size, fill_value=rows)[0]
+                taken = at < rows
+                sub = jax.tree.map(lambda a: a[jnp.minimum(at, rows - 1)], s)
+                sub = jax.lax.switch(k // 2, branches, sub, jnp.minimum(at, rows - 1), j,
+                                     active[jnp.minimum(at, rows - 1)] & taken[:, None])
+                s = jax.tree.map(lambda a, b: a.at[at].set(b, mode="drop"), s, sub)
+                return s, pending.at[at].set(False, mode="drop")
 
-            return jax.lax.fori_loop(0, BODY_OPS, one_op, s)
+            pending = live_rows & (length > j)
+            return jax.lax.while_loop(lambda carry: jnp.any(carry[1]), chunk, (s, pending))[0]
 
         steps = jnp.max(jnp.where(live_rows, length, 0))
         return it + 1, jax.lax.fori_loop(0, steps, position, s)
 
-    def more(carry):
-        it, s = carry
-        return jnp.any(loop_needs_iteration(cfg, s, it))
-
-    return jax.lax.while_loop(more, iterate, (jnp.int32(1), states))[1]
+    return jax.lax.while_loop(lambda carry: jnp.any(alive(carry[1], carry[0])), iterate,
+                              (jnp.int32(1), states))[1]

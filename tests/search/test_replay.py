@@ -37,27 +37,36 @@ def _scenes(seed: int) -> list:
     return [random_scene(rng, n, pointer=bool(n % 2)) for n in (1, 2, 3, 5, 6, 6, 7, 8)]
 
 
-@pytest.mark.parametrize("text", PROGRAMS)
-def test_replayed_loops_end_where_the_whole_program_run_ends(text):
-    program = parse(text)
-    assert "loop_start" in text
-    scenes = _scenes(len(text))
-    consts = stack([load_scene(s) for s in scenes])  # (E, ...)
-    bank = jax.tree.map(lambda a: a[None], consts)  # one task of E examples
-    states = jax.tree.map(lambda a: a[None], jax.vmap(lambda _: init_state(CFG))(jnp.arange(len(scenes))))
-    task = jnp.zeros(1, jnp.int32)
+def _closed_and_replayed(program, bank, task, states):
+    """Step `program` as the search does; return the states after the last replay and
+    whether some replay changed anything."""
     replayed = False
     for op, arg in zip(program.ops, program.args, strict=True):
         closing = op == OP["loop_end"]
-        states = step_examples(CFG, op, bank, task, states, jnp.asarray([arg], jnp.int32), not closing)
+        states = step_examples(CFG, op, bank, task, states, jnp.full(task.shape, arg, jnp.int32), not closing)
         if closing:
             closed = states
             states = replay_loops(CFG, bank, task, states)
             replayed |= any(bool(jnp.any(a != b)) for a, b in zip(jax.tree.leaves(closed), jax.tree.leaves(states)))
+    return states, replayed
+
+
+@pytest.mark.parametrize("text", PROGRAMS)
+def test_replayed_loops_end_where_the_whole_program_run_ends(text):
+    """Each scene a row of one example (a row that fails on its example is dead, so
+    scenes that fail must not share a row with scenes that run on)."""
+    program = parse(text)
+    assert "loop_start" in text
+    scenes = _scenes(len(text))
+    consts = stack([load_scene(s) for s in scenes])  # (E, ...)
+    bank = jax.tree.map(lambda a: a[:, None], consts)  # E tasks of one example each
+    task = jnp.arange(len(scenes), dtype=jnp.int32)
+    root = jax.tree.map(lambda a: a[:, None], jax.vmap(lambda _: init_state(CFG))(task))
+    states, replayed = _closed_and_replayed(program, bank, task, root)
     assert replayed  # some scene runs a second iteration: the replay is exercised
     ops, args, _ = program.arrays(pad_length(len(program.ops)))
     whole = run_batch(CFG, consts, jnp.asarray(ops), jnp.asarray(args))
-    stepped, whole = jax.device_get((jax.tree.map(lambda a: a[0], states), whole))
+    stepped, whole = jax.device_get((jax.tree.map(lambda a: a[:, 0], states), whole))
     for got, want in zip(jax.tree.leaves(stepped), jax.tree.leaves(whole), strict=True):
         np.testing.assert_array_equal(got, want)
     failed = np.asarray(whole.control.failed)
@@ -65,30 +74,51 @@ def test_replayed_loops_end_where_the_whole_program_run_ends(text):
         assert failed.any() and not failed.all()
 
 
+def test_a_program_that_failed_on_one_example_replays_no_further():
+    """A row's program failed on one example (no pointer there): the search drops it, so
+    the replay runs none of its examples further, and it stays failed."""
+    program = parse(PROGRAMS[2])  # fails at once on a scene without a pointer
+    scenes = [s for s in _scenes(3) if len(s.objects) > 2]
+    assert any(s.pointer is None for s in scenes) and any(s.pointer is not None for s in scenes)
+    consts = stack([load_scene(s) for s in scenes])
+    bank = jax.tree.map(lambda a: a[None], consts)  # one task of E examples
+    task = jnp.zeros(1, jnp.int32)
+    root = jax.tree.map(lambda a: a[None], jax.vmap(lambda _: init_state(CFG))(jnp.arange(len(scenes))))
+    states, replayed = _closed_and_replayed(program, bank, task, root)
+    assert not replayed and bool(jnp.any(states.control.failed))
+    alone = jnp.asarray([s.pointer is not None for s in scenes])  # the same scenes, each a row of its own
+    task_ids = jnp.arange(len(scenes), dtype=jnp.int32)
+    rows, _ = _closed_and_replayed(program, jax.tree.map(lambda a: a[:, None], consts), task_ids,
+                                   jax.tree.map(lambda a: a[:, None], jax.vmap(lambda _: init_state(CFG))(task_ids)))
+    assert bool(jnp.any(rows.hand.position[alone, 0] != states.hand.position[0, alone]))  # alone, they ran on
+
+
 def test_one_replay_call_serves_rows_with_different_bodies():
     """Programs whose loops have different bodies, closed separately and replayed together
-    in one call (as a search round does), each end as its whole run ends."""
+    in one call (as a search round does), each end as its whole run ends (each scene a
+    row of one example, as above)."""
     programs = [parse(t) for t in PROGRAMS]
     scenes = _scenes(7)
     consts = stack([load_scene(s) for s in scenes])
-    bank = jax.tree.map(lambda a: a[None], consts)
-    one = jnp.zeros(1, jnp.int32)
+    bank = jax.tree.map(lambda a: a[:, None], consts)  # a task per scene
+    per_scene = jnp.arange(len(scenes), dtype=jnp.int32)
 
-    def run(states, ops, args, replay_at_end):
+    def run(states, tasks, ops, args, replay_at_end):
         for k, (op, arg) in enumerate(zip(ops, args, strict=True)):
             last = replay_at_end and k == len(ops) - 1
-            states = step_examples(CFG, op, bank, one, states, jnp.asarray([arg], jnp.int32), not last)
+            states = step_examples(CFG, op, bank, tasks, states, jnp.full(tasks.shape, arg, jnp.int32), not last)
         return states
 
-    root = jax.tree.map(lambda a: a[None], jax.vmap(lambda _: init_state(CFG))(jnp.arange(len(scenes))))
+    root = jax.tree.map(lambda a: a[:, None], jax.vmap(lambda _: init_state(CFG))(per_scene))
     ends = [p.ops.index(OP["loop_end"]) + 1 for p in programs]  # each program holds one loop
-    closed = [run(root, p.ops[:e], p.args[:e], True) for p, e in zip(programs, ends, strict=True)]
-    batch = jax.tree.map(lambda *a: jnp.concatenate(a), *closed)
-    replayed = replay_loops(CFG, bank, jnp.zeros(len(programs), jnp.int32), batch)
+    closed = [run(root, per_scene, p.ops[:e], p.args[:e], True) for p, e in zip(programs, ends, strict=True)]
+    batch = jax.tree.map(lambda *a: jnp.concatenate(a), *closed)  # rows: programs x scenes
+    replayed = replay_loops(CFG, bank, jnp.tile(per_scene, len(programs)), batch)
+    n = len(scenes)
     for i, (p, e) in enumerate(zip(programs, ends, strict=True)):
-        row = jax.tree.map(lambda a, i=i: a[i : i + 1], replayed)
-        final = run(row, p.ops[e:], p.args[e:], False)
+        rows = jax.tree.map(lambda a, i=i: a[i * n : (i + 1) * n], replayed)
+        final = run(rows, per_scene, p.ops[e:], p.args[e:], False)
         ops, args, _ = p.arrays(pad_length(len(p.ops)))
         whole = run_batch(CFG, consts, jnp.asarray(ops), jnp.asarray(args))
         for got, want in zip(jax.tree.leaves(jax.device_get(final)), jax.tree.leaves(jax.device_get(whole)), strict=True):
-            np.testing.assert_array_equal(got[0], want)
+            np.testing.assert_array_equal(got[:, 0], want)
