@@ -59,18 +59,21 @@ class DeviceCalls:
         self.compiled: set[tuple] = set()  # (key, size) seen
         self.compile_seconds = 0.0  # first calls of each (key, size): compile time, kept apart
 
-    def start(self, key: Hashable, rows: np.ndarray, call: Callable[[RowsOf], object]) -> Pending:
+    def start(self, key: Hashable, rows: np.ndarray, call: Callable[[RowsOf], object],
+              sizes: Sequence[int] | None = None) -> Pending:
         """Start `call(rows_of)` over `rows` in bucket-sized pieces (each padded by repeating
         its first row; `rows_of(a)` gives a host array's rows of the piece) without waiting
         for the results. First calls of a (key, size) compile synchronously and are timed
         as compile time. Returns the pending pieces, for `results`."""
         offset, pending = 0, []
-        for size in self.piece_sizes(len(rows)):
+        for size in piece_sizes(len(rows), sizes) if sizes else self.piece_sizes(len(rows)):
             piece = rows[offset : offset + size]
             padded = np.concatenate([piece, np.full(size - len(piece), piece[0])])
             first = (key, size) not in self.compiled
             t0 = time.perf_counter()
-            pending.append((piece, call(self.rows_on_devices(padded))))
+            rows_of = self.rows_on_devices(padded)
+            rows_of.real = len(piece)  # the piece's rows before the padding
+            pending.append((piece, call(rows_of)))
             if first:
                 jax.block_until_ready(pending[-1][1])
                 self.compiled.add((key, size))
@@ -84,9 +87,10 @@ class DeviceCalls:
         for piece, out in pending:
             yield piece, jax.tree.map(lambda a: np.asarray(a)[: len(piece)], out)  # noqa: B023
 
-    def run(self, key: Hashable, rows: np.ndarray, call: Callable[[RowsOf], object]) -> Iterable:
+    def run(self, key: Hashable, rows: np.ndarray, call: Callable[[RowsOf], object],
+            sizes: Sequence[int] | None = None) -> Iterable:
         """`start` and `results` at once."""
-        return self.results(self.start(key, rows, call))
+        return self.results(self.start(key, rows, call, sizes))
 
     def rows_on_devices(self, padded: np.ndarray) -> RowsOf:
         """What `call` gets: `rows_of(a)`, the padded rows of a host array (`rows_of(a, via)`:

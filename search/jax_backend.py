@@ -1,12 +1,15 @@
 """The search's backend on the JAX emulator: many concepts' children stepped together,
-one device call per instruction.
+one device call per atom position of a round.
 
 The concepts being searched have their example scenes and targets in a bank of
 `width` slots on the device (a fixed shape: each instruction compiles once whatever the
 number of concepts); a batch's rows are programs, each reading its concept's slot.
 On the host a prefix's states are one packed int32 row per example (`search.packing`),
 so a frame is one array and a transfer one copy. A request's children are stepped
-atom by atom (a subroutine is several), each atom's rows grouped by instruction; a
+atom by atom (a subroutine is several): each atom's rows sorted by instruction into
+chunks of a few rows of one instruction, all chunks run in one device call
+(`stepping.step_chunks`, a switch per chunk), so a round makes one call where it made
+one per instruction, and one function compiles where one per instruction did. A
 closed loop's further iterations are replayed in one device call per piece of rows
 (`_replay_loops`). Complete programs are judged on the device.
 
@@ -26,8 +29,13 @@ import numpy as np
 from search.backend import Reply, Request
 from search.device_calls import BUCKETS, DeviceCalls, Pending
 from search.packing import blackboard_columns, pack_state, packed_field, unpack_blackboard, unpack_state
-from search.stepping import EMPTY_HANDED, holding_split, replay_loops, step_examples
+from search.stepping import EMPTY_HANDED, STEP_CHUNK, replay_loops, step_chunks
 from search.task import Task
+
+# One batch size each for the fused step and the replay: their cost follows the rows they
+# run, not the padding (only copied), so one compile each serves every round.
+STEP_ROWS = (256,)
+REPLAY_ROWS = (64,)
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.instructions import OP
 from vccjax.machine.match import ASK, YES, Target, verdict
@@ -68,18 +76,20 @@ def _device_verdicts(cfg: VCCConfig, consts: SceneConst, targets: Target, slots,
     return jax.vmap(row)(slots, unpack_blackboard(boards, cfg))
 
 
-@functools.partial(jax.jit, static_argnums=(0, 1, 6))
-def _advance(cfg: VCCConfig, op: int, consts: SceneConst, slots, packed, args, replay: bool = True):
-    """Step (B, E) packed states, each row a program of the task in slot `slots[row]`, by
-    `op`; return them and whether each program failed on any example."""
-    new = step_examples(cfg, op, consts, slots, unpack_state(packed, cfg), args, replay)
+@functools.partial(jax.jit, static_argnums=0)
+def _advance_chunks(cfg: VCCConfig, consts: SceneConst, slots, packed, row_ops, args, real):
+    """`step_chunks` on packed states: rows come in chunks of `STEP_CHUNK` of one op
+    (`row_ops`, one per row), the chunks holding the first `real` rows run; return the
+    states and whether each program failed on any example."""
+    n_chunks = (real + STEP_CHUNK - 1) // STEP_CHUNK
+    new = step_chunks(cfg, consts, slots, unpack_state(packed, cfg), row_ops[::STEP_CHUNK], args, n_chunks)
     return pack_state(new, cfg), _failed_anywhere(new)
 
 
 @functools.partial(jax.jit, static_argnums=0)
-def _replay_packed(cfg: VCCConfig, consts: SceneConst, slots, packed):
-    """`replay_loops` on packed states."""
-    return pack_state(replay_loops(cfg, consts, slots, unpack_state(packed, cfg)), cfg)
+def _replay_packed(cfg: VCCConfig, consts: SceneConst, slots, packed, real):
+    """`replay_loops` on packed states, the first `real` rows."""
+    return pack_state(replay_loops(cfg, consts, slots, unpack_state(packed, cfg), real), cfg)
 
 
 @functools.lru_cache(maxsize=None)
@@ -186,40 +196,42 @@ class JaxBackend:
     def _step_atoms(self, ops: np.ndarray, args: np.ndarray, slots: np.ndarray, source: np.ndarray,
                     source_row: np.ndarray, children: np.ndarray, failed: np.ndarray) -> None:
         """Step each child not yet failed by its atom `ops[i]` (none where -1), from state
-        `source[source_row[i]]` into `children[i]`; mark `failed` (both in place)."""
-        runs = (ops >= 0) & ~failed
-        groups = {int(op): np.nonzero((ops == op) & ~failed)[0] for op in np.unique(ops[runs])}
-        pending = [self._start_step(op, slots, source, source_row, rows, args) for op, rows in groups.items()]
-        for group in pending:  # every group started before any is waited for
-            for rows, (new, fails) in self.calls.results(group):
-                children[rows] = new
-                failed[rows] |= fails
-        closed = groups.get(OP["loop_end"])
-        if closed is not None:
+        `source[source_row[i]]` into `children[i]`; mark `failed` (both in place). The rows
+        are sorted by op (a carry op's holders apart) into chunks of `STEP_CHUNK` rows of
+        one op, and every chunk runs in one device call per bucket-sized piece."""
+        rows = np.nonzero((ops >= 0) & ~failed)[0]
+        if len(rows) == 0:
+            return
+        op_of = ops[rows]
+        carry = np.isin(op_of, list(EMPTY_HANDED))
+        holds = np.zeros(len(rows), bool)
+        if carry.any():
+            holds[carry] = _holding_rows(source, source_row[rows[carry]], self.cfg)
+        key = 2 * op_of + holds
+        order = np.argsort(key, kind="stable")
+        rows, key = rows[order], key[order]
+        starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+        counts = np.diff(np.r_[starts, len(rows)])
+        padded = -(-counts // STEP_CHUNK) * STEP_CHUNK  # each op's rows to whole chunks, repeating its first
+        at = np.repeat(starts, padded) + np.minimum(
+            np.arange(padded.sum()) - np.repeat(np.cumsum(padded) - padded, padded), np.repeat(counts - 1, padded))
+        batch, row_ops = rows[at], ops[rows[at]]
+        real = at != np.r_[-1, at[:-1]]  # the first occurrence of each row: the others are padding
+        cfg, (consts, _) = self.cfg, self._bank
+        pending = self.calls.start(
+            ("chunks", source.shape[1]), np.arange(len(batch)),
+            lambda rows_of: _advance_chunks(cfg, consts, rows_of(slots, batch), rows_of(source, source_row[batch]),
+                                            rows_of(row_ops), rows_of(args, batch), rows_of.real),
+            STEP_ROWS)
+        for piece, (new, fails) in self.calls.results(pending):
+            keep = real[piece]
+            children[batch[piece[keep]]] = new[keep]
+            failed[batch[piece[keep]]] |= fails[keep]
+        closed = rows[ops[rows] == OP["loop_end"]]
+        if len(closed):
             closed = closed[~failed[closed]]
             self._replay_loops(slots, children, closed)
             failed[closed] |= _failed_rows(children, closed, self.cfg)
-
-    def _start_step(self, op: int, slots: np.ndarray, source: np.ndarray, source_row: np.ndarray,
-                    rows: np.ndarray, args: np.ndarray) -> Pending:
-        """Start stepping rows `rows` of the batch by `op`, row i's state being
-        `source[source_row[i]]` (packed, (n, E, P)); see `DeviceCalls.start`."""
-        cfg, (consts, _) = self.cfg, self._bank
-        replay_in_step = op != OP["loop_end"]  # a closed loop's further iterations: `_replay_loops`
-        pending = []
-        for part in self._holding_parts(op, source, source_row[rows], rows):
-            pending += self.calls.start(
-                ("step", op, source.shape[1]), part,
-                lambda rows_of: _advance(cfg, op, consts, rows_of(slots), rows_of(source, source_row), rows_of(args),
-                                         replay_in_step))
-        return pending
-
-    def _holding_parts(self, op: int, source: np.ndarray, source_rows: np.ndarray,
-                       rows: np.ndarray) -> list[np.ndarray]:
-        """`rows` (states `source[source_rows]`) cut as `stepping.holding_split` says."""
-        if op not in EMPTY_HANDED:
-            return [rows]
-        return holding_split(op, rows, _holding_rows(source, source_rows, self.cfg), self.calls.piece_sizes)
 
     def _replay_loops(self, slots: np.ndarray, states: np.ndarray, rows: np.ndarray) -> None:
         """A closed loop's remaining iterations for `states[rows]` (in place), each piece of
@@ -227,7 +239,8 @@ class JaxBackend:
         cfg, (consts, _) = self.cfg, self._bank
         for done_rows, new in self.calls.run(
                 ("replay", states.shape[1]), rows,
-                lambda rows_of: _replay_packed(cfg, consts, rows_of(slots), rows_of(states))):
+                lambda rows_of: _replay_packed(cfg, consts, rows_of(slots), rows_of(states), rows_of.real),
+                REPLAY_ROWS):
             states[done_rows] = new
 
     def _children_room(self, shape: tuple, dtype) -> np.ndarray:

@@ -122,7 +122,8 @@ _CARRIES = np.array([op in EMPTY_HANDED for op in range(BODY_OPS)])  # body ops 
 
 
 @functools.partial(jax.jit, static_argnums=0)
-def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState) -> VCCState:
+def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState,
+                 real: jax.Array | None = None) -> VCCState:
     """Every further iteration of the loops just closed in (B, E) states (a `loop_end`
     stepped with replay=False), in one device call: the host's replay of one call per
     (iteration, position, instruction), without the host round trips.
@@ -133,7 +134,8 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
     do not), gathered and run by a switch on an unbatched index (`replay_examples`), so
     only that instruction's code runs, only for those rows: the cost follows the rows
     still looping, not the batch. A program that failed on some example is dead (the
-    search drops it): none of its examples runs further."""
+    search drops it): none of its examples runs further. Rows from `real` on are padding:
+    they are not run (returned as they came)."""
     ctl = states.control
     ops, args = ctl.body_ops[:, 0], ctl.body_args[:, 0]  # (B, L): a body is the same on every example
     length, pc0 = ctl.body_len[:, 0], ctl.body_pc0[:, 0]
@@ -147,8 +149,11 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
 
     branches = [branch(op) for op in range(BODY_OPS)]
 
+    padding = jnp.arange(rows) >= (rows if real is None else real)
+
     def alive(s, it):
-        return loop_needs_iteration(cfg, s, it) & ~jnp.any(s.control.failed, axis=1, keepdims=True)
+        dead = jnp.any(s.control.failed, axis=1) | padding
+        return loop_needs_iteration(cfg, s, it) & ~dead[:, None]
 
     def iterate(carry):
         it, s = carry
@@ -179,3 +184,32 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
 
     return jax.lax.while_loop(lambda carry: jnp.any(alive(carry[1], carry[0])), iterate,
                               (jnp.int32(1), states))[1]
+
+
+STEP_CHUNK = 4  # rows of one instruction a fused step runs at a time
+
+
+@functools.partial(jax.jit, static_argnums=0)
+def step_chunks(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState, chunk_ops: jax.Array,
+                args: jax.Array, n_chunks: jax.Array) -> VCCState:
+    """Step (B, E) states whose rows come in chunks of `STEP_CHUNK` rows of one op each
+    (`chunk_ops`, (B // STEP_CHUNK,)), the first `n_chunks` chunks only, in one device
+    call: per chunk a switch on an unbatched index runs that op's code (`step_examples`;
+    a `loop_end` only closes the loop, its further iterations are `replay_loops`')."""
+    size = STEP_CHUNK
+
+    def branch(op):
+        def run(c_tasks, s, a):
+            return step_examples(cfg, op, consts, c_tasks, s, a, op != OP["loop_end"])
+        return run
+
+    branches = [branch(op) for op in range(len(OP))]
+
+    def chunk(i, s):
+        start = i * size
+        part = jax.tree.map(lambda a: jax.lax.dynamic_slice_in_dim(a, start, size), s)
+        new = jax.lax.switch(chunk_ops[i], branches, jax.lax.dynamic_slice_in_dim(tasks, start, size), part,
+                             jax.lax.dynamic_slice_in_dim(args, start, size))
+        return jax.tree.map(lambda a, b: jax.lax.dynamic_update_slice_in_dim(a, b, start, 0), s, new)
+
+    return jax.lax.fori_loop(0, n_chunks, chunk, states)
