@@ -61,9 +61,10 @@ class DeviceCalls:
 
     def start(self, key: Hashable, rows: np.ndarray, call: Callable[[RowsOf], object],
               sizes: Sequence[int] | None = None) -> Pending:
-        """Start `call(rows_of)` over `rows` in bucket-sized pieces (each padded by repeating
-        its first row; `rows_of(a)` gives a host array's rows of the piece) without waiting
-        for the results. First calls of a (key, size) compile synchronously and are timed
+        """Start `call(rows_of)` over `rows` in bucket-sized pieces (`sizes`, default this
+        caller's buckets; each padded by repeating its first row; `rows_of(a)` gives a host
+        array's rows of the piece, `rows_of.real` its rows before the padding) without
+        waiting for the results. First calls of a (key, size) compile synchronously and are timed
         as compile time. Returns the pending pieces, for `results`."""
         offset, pending = 0, []
         for size in piece_sizes(len(rows), sizes) if sizes else self.piece_sizes(len(rows)):

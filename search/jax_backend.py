@@ -198,7 +198,7 @@ class JaxBackend:
         """Step each child not yet failed by its atom `ops[i]` (none where -1), from state
         `source[source_row[i]]` into `children[i]`; mark `failed` (both in place). The rows
         are sorted by op (a carry op's holders apart) into chunks of `STEP_CHUNK` rows of
-        one op, and every chunk runs in one device call per bucket-sized piece."""
+        one op, and all the chunks run in one device call per piece of `STEP_ROWS` rows."""
         rows = np.nonzero((ops >= 0) & ~failed)[0]
         if len(rows) == 0:
             return
@@ -212,7 +212,7 @@ class JaxBackend:
         rows, key = rows[order], key[order]
         starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
         counts = np.diff(np.r_[starts, len(rows)])
-        padded = -(-counts // STEP_CHUNK) * STEP_CHUNK  # each op's rows to whole chunks, repeating its first
+        padded = -(-counts // STEP_CHUNK) * STEP_CHUNK  # each op's rows to whole chunks, repeating its last
         at = np.repeat(starts, padded) + np.minimum(
             np.arange(padded.sum()) - np.repeat(np.cumsum(padded) - padded, padded), np.repeat(counts - 1, padded))
         batch, row_ops = rows[at], ops[rows[at]]

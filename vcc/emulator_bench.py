@@ -201,7 +201,10 @@ def step_reference(p: Prepared) -> tuple[list[list[RefMachine]], dict[int, float
 
 
 def agree(p: Prepared, jax_out: dict, ref_kids: list) -> bool:
-    """Failure flags and blackboards of every child on every example."""
+    """Failure flags and blackboards of every child on every example. A replayed loop
+    stops a program that failed on some example (the search drops it), so for `loop_end`
+    children the flags agree as "failed on some example", and the blackboards of those
+    that ran on every example."""
     consts = jax.device_get(p.consts)
     for op, results in jax_out.items():
         g = p.groups[op]
@@ -210,6 +213,12 @@ def agree(p: Prepared, jax_out: dict, ref_kids: list) -> bool:
             for k, i in enumerate(idx):
                 r = int(g["rows"][i])
                 j = p.children[r][0]
+                if op == OP["loop_end"]:
+                    dead = bool(states.control.failed[k].any())
+                    if dead != any(m.failed for m in ref_kids[r]):
+                        return False
+                    if dead:
+                        continue
                 for e, m in enumerate(ref_kids[r]):
                     if bool(states.control.failed[k, e]) != m.failed:
                         return False
