@@ -49,7 +49,7 @@ def cmd_data(a: argparse.Namespace) -> int:
 
     from argpred.data import build, built
 
-    joined = 0.0 if a.kind == "carry" else a.joined
+    joined = 0.0 if a.kind != "drawn" else a.joined
     m = build(a.out, a.programs, seed=a.seed, workers=a.workers or os.cpu_count() or 1, progress=not a.quiet,
               joined=joined, kind=a.kind)
     print(f"{len(m['shards'])} shards ({built(a.out)['programs']} {a.kind} programs) in {a.out}")
@@ -87,13 +87,14 @@ def cmd_train(a: argparse.Namespace) -> int:
         argdata.build(folder, programs, seed=have["seed"] if have else a.seed,
                       workers=a.workers or os.cpu_count() or 1, progress=not a.quiet, joined=joined)
         data = argdata.load(folder)
-    if a.carry and not any((argdata.built(f) or {}).get("kind") == "carry" for f in folders):
-        carry = DEFAULT_DATA / f"seed{a.seed}-carry{a.carry}"  # the carry programs (argpred.data.carry_program)
-        argdata.build(carry, a.carry, seed=a.seed, progress=not a.quiet, kind="carry")
-        more = argdata.load(carry)
-        data = {k: np.concatenate([data[k], more[k]]) for k in data}
+    for kind, n in (("carry", a.carry), ("loop", a.loops)):  # argpred.data.carry_program, loop_program
+        if n and not any((argdata.built(f) or {}).get("kind") == kind for f in folders):
+            extra = DEFAULT_DATA / f"seed{a.seed}-{kind}{n}"
+            argdata.build(extra, n, seed=a.seed, progress=not a.quiet, kind=kind)
+            more = argdata.load(extra)
+            data = {k: np.concatenate([data[k], more[k]]) for k in data}
     settings = TrainSettings(hidden=a.hidden, kernel=a.kernel, depth=a.depth, evidence=a.evidence,
-                             bias_start=a.bias_start, epochs=a.epochs, batch=a.batch, learning_rate=a.lr, l1=a.l1,
+                             bias_start=a.bias_start, pool=a.pool, epochs=a.epochs, batch=a.batch, learning_rate=a.lr, l1=a.l1,
                              positive_weight=a.positive_weight, seed=a.seed)
     model, params, histories = train_members(data, settings, a.members, checkpoint=out.with_suffix(".ckpt"),
                                              workers=a.workers or os.cpu_count() or 1, progress=not a.quiet)
@@ -159,9 +160,10 @@ def add_commands(sub) -> None:
     d.add_argument("--joined", type=runtime.number(0, 1), default=0.3,
                    help="share of programs drawn as two parts joined by reset_attn (default 0.3, as the "
                         "shipped weights)")
-    d.add_argument("--kind", choices=("drawn", "carry"), default="drawn",
+    d.add_argument("--kind", choices=("drawn", "carry", "loop"), default="drawn",
                    help="drawn (default): programs of 3 to 6 instructions; carry: an object carried onto "
-                        "another one (what `train --carry` adds)")
+                        "another one (what `train --carry` adds); loop: one change done to every attended object "
+                        "(what `train --loops` adds)")
     d.add_argument("--workers", type=runtime.count(0, 256), default=0, help="processes (default: one per core)")
     d.add_argument("--quiet", action="store_true")
     d.set_defaults(fn=cmd_data)
@@ -197,6 +199,12 @@ def add_commands(sub) -> None:
     t.add_argument("--carry", type=runtime.count(0, 10**6), default=30,
                    help="carry programs (an object carried onto another one: 10 instructions, beyond the drawn "
                         "six) added to the data, drawn into DEFAULT/seedS-carryN (default 30; 0: none)")
+    t.add_argument("--pool", choices=("labels", "hidden"), default="labels",
+                   help="labels (default): each label's map max-pooled over the grid; hidden: the hidden channels "
+                        "pooled, then a dense layer (a label can weigh the whole grid)")
+    t.add_argument("--loops", type=runtime.count(0, 10**6), default=0,
+                   help="loop programs (one change done to every attended object, after an optional filter) "
+                        "added to the data, drawn into DEFAULT/seedS-loopN (default 0: none)")
     t.add_argument("--members", type=runtime.count(1, 64), default=3,
                    help="networks trained from seeds S, S+1, ... whose probabilities are averaged (default 3)")
     t.add_argument("--seed", type=runtime.count(0), default=0)

@@ -51,7 +51,7 @@ PREDICTED: tuple[str, ...] = ("set_shape_attn", "set_color_attn", "fill_color")
 LABELS: tuple[tuple[str, str], ...] = tuple((f, v) for f in PREDICTED for v in arg_domain(f))
 FORMAT, VERSION = "vccjax-argpred-data", 1
 SHARD = 100  # programs per shard file
-KINDS = ("drawn", "carry")
+KINDS = ("drawn", "carry", "loop")
 LENGTHS = (3, 6)  # scene_parse and one instruction change no scene; 6 as the paper (8: docs/argpred.md)
 _DRAWABLE = tuple(op for op in range(len(NAMES)) if op != OP["scene_parse"])
 
@@ -215,10 +215,40 @@ def carry_program(rng: np.random.Generator, fill: float = 0.25) -> Program:
     return Program(tuple(OP[n] for n, _ in steps), tuple(0 if a is None else arg_domain(n).index(a) for n, a in steps))
 
 
-def kept_carry(rng: np.random.Generator, max_tries: int = 60) -> tuple[Program, list[tuple[Scene, Scene]]]:
-    """A carry program whose 10 examples can be drawn, made minimal (as `kept_program`)."""
+_MOVES = ("move_hand_left", "move_hand_right", "move_hand_up", "move_hand_down")
+
+
+def loop_program(rng: np.random.Generator) -> Program:
+    """Do one thing to every attended object: an optional selection (a shape or colour
+    filter, both, or a fixation), then a loop whose body recolours the object, moves it
+    one hand step or two at a right angle, or both (docs/vcc.md section 5)."""
+    k = int(rng.integers(5))  # none, shape, colour, both filters, a fixation
+    pick = ([] if k == 0 else _selector(rng, filters_only=True) if k < 3 else
+            [*_one_filter(rng, 0), *_one_filter(rng, 1)] if k == 3 else
+            [("fixate", arg_domain("fixate")[int(rng.integers(len(arg_domain("fixate"))))])])
+    colour = ("fill_color", arg_domain("fill_color")[int(rng.integers(len(arg_domain("fill_color"))))])
+    kind = int(rng.integers(3))  # recolour, move, both
+    first = int(rng.integers(len(_MOVES)))
+    turns = [first] + ([(first // 2 * 2 + 2 + int(rng.integers(2))) % 4] if rng.random() < 0.5 else [])
+    move = [("move_hand_to_attended_object", None), ("grab_object", None), *[(_MOVES[d], None) for d in turns],
+            ("release_object", None)]
+    body = [colour] if kind == 0 else move if kind == 1 else [colour, *move]
+    steps = [("scene_parse", None), *pick, ("loop_start", None), ("top_down_attend", None), *body,
+             ("next_object", None), ("loop_end", None)]
+    return Program(tuple(OP[n] for n, _ in steps), tuple(0 if a is None else arg_domain(n).index(a) for n, a in steps))
+
+
+def _one_filter(rng: np.random.Generator, which: int) -> list[tuple[str, str]]:
+    f = PREDICTED[which]
+    return [(f, arg_domain(f)[int(rng.integers(len(arg_domain(f))))])]
+
+
+def kept_carry(rng: np.random.Generator, max_tries: int = 60,
+               draw: Callable[[np.random.Generator], Program] = carry_program) -> tuple[Program, list[tuple[Scene, Scene]]]:
+    """A program of `draw` (carry or loop) whose 10 examples can be drawn, made minimal
+    (as `kept_program`)."""
     while True:
-        program = carry_program(rng)
+        program = draw(rng)
         try:
             pairs = make_pairs(program, TRAIN, rng, jitter=None, max_tries=max_tries)
         except ExampleError:
@@ -233,6 +263,8 @@ def build_shard(seed: int, shard: int, size: int = SHARD, joined: float = 0.0,
     programs (`carry_program`) instead."""
     if kind == "carry":
         key = [seed, shard, 0xCA77]
+    elif kind == "loop":
+        key = [seed, shard, 0x100F]
     else:
         key = [seed, shard, 0xA59] + ([int(round(joined * 1000))] if joined else [])
     rng = np.random.default_rng(key)
@@ -240,7 +272,8 @@ def build_shard(seed: int, shard: int, size: int = SHARD, joined: float = 0.0,
     seen: set = set()
     pool = scene_pool(rng) if kind == "drawn" else {}
     while len(progs) < size:
-        program, pairs = kept_program(rng, pool, joined=joined) if kind == "drawn" else kept_carry(rng)
+        program, pairs = (kept_program(rng, pool, joined=joined) if kind == "drawn" else
+                          kept_carry(rng, draw=loop_program if kind == "loop" else carry_program))
         if (program.ops, program.args) in seen:
             continue
         seen.add((program.ops, program.args))
@@ -274,8 +307,8 @@ def build(out: str | Path, programs: int, seed: int = 0, workers: int = 1,
 
     if kind not in KINDS:
         raise ValueError(f"unknown kind of training data {kind!r} (one of {', '.join(KINDS)})")
-    if kind == "carry" and joined:
-        raise ValueError("carry programs are not joined; use joined=0 for kind 'carry'")
+    if kind != "drawn" and joined:
+        raise ValueError(f"{kind} programs are not joined; use joined=0 for kind {kind!r}")
     out = Path(out)
     files.hold(out, "data folder")  # one builder at a time
     n = -(-programs // SHARD)

@@ -43,12 +43,12 @@ class Predictor:
         return {f: np.array([p[LABELS.index((f, v))] for v in arg_domain(f)]) for f in PREDICTED}
 
 
-def argument_logp(probs: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def argument_logp(probs: dict[str, np.ndarray], threshold: float = THRESHOLD) -> dict[str, np.ndarray]:
     """log p(argument | function) for the search: proportional to the predicted
-    probability over the arguments that pass, -inf elsewhere (all -inf: left out)."""
+    probability over the arguments that pass `threshold`, -inf elsewhere (all -inf: left out)."""
     out = {}
     for f, p in probs.items():
-        keep = p >= THRESHOLD
+        keep = p >= threshold
         lp = np.full(len(p), -np.inf)
         if keep.any():
             lp[keep] = np.log(p[keep] / p[keep].sum())

@@ -35,6 +35,7 @@ class TrainSettings:
     depth: int = 1
     evidence: str = "relu"  # or "signed", the paper's plain sum (argpred.model)
     bias_start: float = -4.0
+    pool: str = "labels"  # or "hidden" (argpred.model)
     epochs: int = 30
     batch: int = 64
     learning_rate: float = 3e-3
@@ -46,7 +47,7 @@ class TrainSettings:
 
 def model_of(settings: TrainSettings) -> ArgNet:
     return ArgNet(hidden=settings.hidden, kernel=settings.kernel, depth=settings.depth, evidence=settings.evidence,
-                  bias_start=settings.bias_start)
+                  bias_start=settings.bias_start, pool=settings.pool)
 
 
 def _l1(params) -> jax.Array:

@@ -60,7 +60,7 @@ def save(path: str | Path, model: ArgNet, params: dict, info: dict | None = None
     data = serialization.to_bytes(jax.device_get(params))
     sha = hashlib.sha256(data).hexdigest()
     shape = {"hidden": model.hidden, "kernel": model.kernel, "depth": model.depth, "evidence": model.evidence,
-             "members": members_of(params)}
+             "members": members_of(params), **({"pool": model.pool} if model.pool != "labels" else {})}
     card = {"format": FORMAT, "version": VERSION, "model": shape,
             "labels": [list(x) for x in LABELS], "sha256": sha, **(info or {})}
     if not all(bool(np.isfinite(np.asarray(w)).all()) for w in jax.tree.leaves(params)):
@@ -134,8 +134,11 @@ def load(path: str | Path | None = None) -> tuple[ArgNet, dict, dict]:
     try:
         model = ArgNet(hidden=int(card["model"]["hidden"]), kernel=int(card["model"]["kernel"]),
                        depth=int(card["model"].get("depth", 1)),
-                       evidence=str(card["model"].get("evidence", "signed")))
+                       evidence=str(card["model"].get("evidence", "signed")),
+                       pool=str(card["model"].get("pool", "labels")))
         members = int(card["model"].get("members", 1))
+        if model.pool not in ("labels", "hidden") or model.evidence not in ("signed", "relu"):
+            raise ValueError(f"model pool {model.pool!r} / evidence {model.evidence!r} unknown")
         for name, value, low, top in (("hidden", model.hidden, 0, MAX_HIDDEN), ("kernel", model.kernel, 1, 15),
                                       ("depth", model.depth, 1, 8), ("members", members, 1, 64)):
             if not low <= value <= top:  # a card may not make us allocate without bound

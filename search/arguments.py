@@ -43,9 +43,11 @@ def used_values(program: Program, name: str) -> list[int]:
 
 
 def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None, answer: Program | None = None,
-                  fixate: Sequence[str] | None = None, fallback: bool = False) -> dict[int, np.ndarray]:
+                  fixate: Sequence[str] | None = None, fallback: bool = False,
+                  threshold: float | None = None) -> dict[int, np.ndarray]:
     """log p(argument | instruction) under `mode` (see the module's docstring). `answer`
-    is needed by oracle and, without `fixate`, by +fixation; `pairs` by predicted."""
+    is needed by oracle and, without `fixate`, by +fixation; `pairs` by predicted, which
+    keeps the arguments at or above `threshold` (default the paper's 0.55)."""
     if mode not in MODES:
         raise ValueError(f"--args must be one of {', '.join(MODES)}, got {mode!r}")
     out = uniform_args()
@@ -54,12 +56,12 @@ def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
             raise ValueError("--args oracle reads the concept's answer program, and this concept has none")
         return {OP[name]: uniform_over(used_values(answer, name), name) for name in NAMES if arg_domain(name)}
     if mode.startswith("predicted"):
-        from argpred.predict import argument_logp as predicted, default_predictor
+        from argpred.predict import THRESHOLD, argument_logp as predicted, default_predictor
 
         if not pairs:
             raise ValueError("--args predicted needs the concept's training pairs")
         probs = default_predictor().for_pairs(pairs)
-        for name, lp in predicted(probs).items():
+        for name, lp in predicted(probs, THRESHOLD if threshold is None else threshold).items():
             if fallback and not np.isfinite(lp).any():
                 p = np.asarray(probs[name], np.float64)
                 lp = np.log(p / p.sum())

@@ -20,7 +20,8 @@ def cmd_induce(a: argparse.Namespace) -> int:
 
         ray_module()  # a missing extra fails now, with its message
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
-                        epsilon=a.epsilon, max_iterations=a.iterations, parts=a.parts)
+                        epsilon=a.epsilon, max_iterations=a.iterations, parts=a.parts,
+                        arg_threshold=a.arg_threshold)
     if a.dataset:  # any built dataset: the concepts its manifest holds, their stored programs as answers
         from vccjax.world.dataset import Dataset
 
@@ -131,6 +132,9 @@ def add_commands(sub) -> None:
     p.add_argument("--subroutines", choices=["on", "off"], default="on")
     p.add_argument("--epsilon", type=runtime.number(0, 1), default=0.1, help="pseudocount (default 0.1)")
     p.add_argument("--iterations", type=runtime.count(1, 100), default=8, help="explore-compress iterations at most")
+    p.add_argument("--arg-threshold", type=runtime.number(0, 1, above=True), default=0.55,
+                   help="with --args predicted: an argument passes at this predicted probability (default 0.55, "
+                        "the paper's); a function none of whose arguments pass is left out")
     p.add_argument("--parts", type=runtime.count(1, 3), default=1,
                    help="2 or 3: after the iterations, a last pass over the concepts still missed, each "
                         "searched whole with the model of everything found and, where that fails, in up to "

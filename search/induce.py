@@ -53,6 +53,7 @@ class Settings:
     max_subroutines: int = 100
     delta: float = 0.01  # nats per cost bin
     parts: int = 1  # >= 2: a last pass over missed concepts, whole then in up to this many parts (1: none)
+    arg_threshold: float = 0.55  # predicted arguments pass at this probability (the paper's 0.55)
 
     def __post_init__(self) -> None:
         if self.args not in ARG_MODES:
@@ -63,6 +64,8 @@ class Settings:
             raise ValueError("--budget must be positive")
         if not 1 <= self.parts <= 3:
             raise ValueError(f"--parts must be 1, 2 or 3, got {self.parts}")
+        if not 0 < self.arg_threshold <= 1:
+            raise ValueError(f"--arg-threshold must be above 0 and at most 1, got {self.arg_threshold}")
 
 
 def needs_answer(settings: Settings) -> bool:
@@ -79,7 +82,7 @@ def argument_logp(settings: Settings, concept: str, pairs: Sequence[tuple[Scene,
 
     if answer is None and needs_answer(settings):
         answer = reference_program(concept)
-    return logp(settings.args, pairs, answer)
+    return logp(settings.args, pairs, answer, threshold=settings.arg_threshold)
 
 
 def fit_model(programs: Sequence[Program], settings: Settings, with_subroutines: bool):
@@ -216,10 +219,11 @@ class Run:
 def same_search(recorded: object, mine: dict) -> bool:
     """Whether a run folder's recorded settings search as `mine`: all alike but `parts`,
     which only adds a pass after the iterations (a folder written before it existed
-    holds none), so a finished run may be resumed to add it."""
+    holds none), so a finished run may be resumed to add it. A folder written before
+    `arg_threshold` existed searched at 0.55."""
     if not isinstance(recorded, dict):
         return False
-    return {**recorded, "parts": 0} == {**mine, "parts": 0}
+    return {"arg_threshold": 0.55, **recorded, "parts": 0} == {**mine, "parts": 0}
 
 
 def read_records(path: Path) -> list[dict]:

@@ -6,6 +6,10 @@ beliefs under the run's `--args`): either some argument the program needs has no
 probability (an argument the predictor did not predict, or fixation guidance left out),
 or the program has a rank under that model, which lies past the run's budget (the search
 covers the budget's most probable programs). docs/search.md lists the result.
+
+`--model K` ranks under the run's model-K.json instead (model-0: the uniform start), and
+`--concepts` names the concepts to rank, found or not: where a concept stood at an
+earlier iteration, for instance the first loop concept under the uniform start.
 """
 
 from __future__ import annotations
@@ -37,7 +41,10 @@ def _found_elsewhere(folders: list[Path], concepts: set[str]) -> dict[str, list]
     return out
 
 
-def why_missed(folder: Path, others: list[Path] = ()) -> dict:
+def why_missed(folder: Path, others: list[Path] = (), model_index: int | None = None,
+               concepts: list[str] | None = None) -> dict:
+    """Each missed concept's (or each of `concepts`') cheapest known program and its rank
+    under the run's last model (or model-`model_index`.json)."""
     from search.arguments import argument_logp
     from search.chain import Chain
     from search.model import MarkovModel, Vocabulary
@@ -52,9 +59,18 @@ def why_missed(folder: Path, others: list[Path] = ()) -> dict:
     records = [json.loads(line) for line in (folder / "results.jsonl").read_text().splitlines() if line.strip()]
     found = {r["concept"] for r in records if r["found"]}
     missed = sorted({r["concept"] for r in records} - found)
+    if concepts is not None:
+        unknown = sorted(set(concepts) - {r["concept"] for r in records})
+        if unknown:
+            raise DataFileError(f"{folder}: the run searched no concept {', '.join(unknown[:3])}")
+        missed = list(concepts)
     models = sorted(folder.glob("model-*.json"), key=lambda p: int(p.stem.split("-")[1]))
     if not models:
         raise DataFileError(f"{folder}: no model-K.json (not a vcc induce run folder)")
+    if model_index is not None:
+        models = [m for m in models if m.stem == f"model-{model_index}"]
+        if not models:
+            raise DataFileError(f"{folder}: no model-{model_index}.json")
     content = read_json(models[-1], DataFileError, "missing")
     vocab = Vocabulary.from_json(content["subroutines"])
     model = MarkovModel(np.array(content["logp"], float), int(content["order"]), float(settings["epsilon"]))
@@ -63,7 +79,8 @@ def why_missed(folder: Path, others: list[Path] = ()) -> dict:
     known = _found_elsewhere(others, set(missed))
     for c in missed:
         answer = reference_program(c)
-        logp = argument_logp(settings["args"], ds.pairs(c, "train"), answer)
+        logp = argument_logp(settings["args"], ds.pairs(c, "train"), answer,
+                             threshold=settings.get("arg_threshold", 0.55))
         chain = Chain(vocab, model, logp, float(settings.get("delta", 0.01)))
         row = {"concept": c, "instructions": len(answer.ops)}
 
@@ -92,7 +109,8 @@ def why_missed(folder: Path, others: list[Path] = ()) -> dict:
         rows.append(row)
     from argpred.weights import load as load_weights
 
-    return {"run": str(folder), "settings": settings, "model": models[-1].name, "concepts": len(set(found) | set(missed)),
+    return {"run": str(folder), "settings": settings, "model": models[-1].name,
+            "concepts": len({r["concept"] for r in records}),
             "found": len(found), "predictor_sha256": load_weights()[2]["sha256"],
             "run_predictor_sha256": meta.get("predictor_sha256"), "misses": rows}
 
@@ -102,14 +120,17 @@ def cmd_bench_misses(a: argparse.Namespace) -> int:
 
     runtime.prepare()
     others = [Path(x) for x in a.known.split(",") if x.strip()]
-    report = {**stamp(a, "misses"), "benchmark": "misses", **why_missed(Path(a.run), others)}
+    concepts = [c for c in a.concepts.split(",") if c] if a.concepts else None
+    report = {**stamp(a, "misses"), "benchmark": "misses",
+              **why_missed(Path(a.run), others, model_index=a.model, concepts=concepts)}
     files.write_json(a.out, report)
     for r in report["misses"]:
         why = (", ".join(r["unpredicted"]) + " not predicted" if r["why"] == "argument not predicted"
                else f"rank {r['rank']:,}" if r["rank"] is not None else "rank past 4.6e18")
         why += "" if r["why"] == "argument not predicted" else f" ({r['nats']} nats) under {report['model']}"
         print(f"{r['concept']} ({r['instructions']} instructions): {why}")
-    print(f"{len(report['misses'])} missed of {report['concepts']}   -> {a.out}")
+    what = "ranked" if concepts is not None else "missed"
+    print(f"{len(report['misses'])} {what} of {report['concepts']}   -> {a.out}")
     if report["run_predictor_sha256"] not in (None, report["predictor_sha256"]):
         print("(the run was made with other argument-predictor weights than these: predicted arguments may differ)")
     return 0
@@ -123,6 +144,10 @@ def add_command(bsub) -> None:
     m.add_argument("--run", required=True, help="a vcc induce run folder (run.json, results.jsonl, model-K.json)")
     m.add_argument("--known", default="benchmarks/induction,benchmarks/reproduce",
                    help="folders whose runs' found programs count as known programs too (comma-separated; '' none)")
+    m.add_argument("--model", type=runtime.count(0), default=None,
+                   help="rank under the run's model-K.json (default: its last; 0: the uniform start)")
+    m.add_argument("--concepts", type=runtime.name_list, default=None,
+                   help="concepts to rank, found or not (comma-separated; default: the ones the run missed)")
     m.add_argument("--out", default="benchmarks/results/misses.json", type=runtime.out_file(".json"),
                    help="result JSON")
     m.set_defaults(fn=cmd_bench_misses)

@@ -15,7 +15,7 @@ from argpred.train import TrainSettings, train
 from argpred.model import ArgNet
 from argpred.weights import init_params, load, save
 from vccjax.errors import DataFileError
-from vccjax.machine.program import parse
+from vccjax.machine.program import check_loop_syntax, parse
 from vccjax.machine.scene import Scene, SceneObject
 
 
@@ -139,6 +139,27 @@ def test_weights_round_trip_and_refuse_corrupt_or_foreign_files(tiny, tmp_path):
         load(tmp_path / "none.msgpack")
 
 
+def test_loop_programs_do_one_change_to_every_attended_object(tmp_path):
+    folder = tmp_path / "loop"
+    argdata.build(folder, 6, seed=3, progress=False, kind="loop")
+    assert argdata.built(folder) == {"programs": 6, "seed": 3, "joined": 0.0, "kind": "loop"}
+    d = argdata.load(folder)
+    assert d["inputs"].shape == (6, 10, 9, 4)
+    for text, labels in zip(d["programs"], d["labels"]):
+        program = parse(text)
+        check_loop_syntax(program)  # a whole loop: loop_start; top_down_attend; ...; next_object; loop_end
+        steps = text.split("; ")
+        assert steps[-1] == "loop_end" and steps[-2] == "next_object" and steps.count("loop_start") == 1
+        before = steps[: steps.index("loop_start")]  # only a selection before the loop
+        assert all(s.split("(")[0] in ("scene_parse", "set_shape_attn", "set_color_attn", "fixate") for s in before)
+        assert np.array_equal(labels, argdata.labels_of(program))
+    again = argdata.build_shard(3, 0, size=6, kind="loop")
+    with np.load(folder / "shard0000.npz") as z:
+        assert all(np.array_equal(z[k], again[k]) for k in again)
+    with pytest.raises(DataFileError, match="kind loop"):
+        argdata.build(folder, 6, seed=3, progress=False, kind="carry")  # another kind into a loop folder: refused
+
+
 def test_carry_programs_are_seeded_two_attend_procedures_in_their_own_folder(tmp_path):
     folder = tmp_path / "carry"
     argdata.build(folder, 5, seed=2, progress=False, kind="carry")
@@ -158,6 +179,35 @@ def test_carry_programs_are_seeded_two_attend_procedures_in_their_own_folder(tmp
         argdata.build(tmp_path / "other", 5, seed=2, progress=False, kind="carry", joined=0.3)
     with pytest.raises(ValueError, match="unknown kind"):
         argdata.build(tmp_path / "other", 5, kind="enumerated")
+
+
+def test_pooling_the_hidden_channels_weighs_the_whole_grid_and_round_trips(tiny, tmp_path):
+    """pool="hidden": each example's logits are a dense layer of its hidden channels'
+    maxima over the grid (so a unit firing anywhere can lower a label), as computed here
+    by hand; the card says so and the weights load back as that model."""
+    import jax
+    import jax.numpy as jnp
+
+    from argpred.features import features_from_cells
+
+    d = argdata.load(tiny)
+    model, params, _ = train(d, TrainSettings(hidden=4, epochs=1, batch=8, pool="hidden"), progress=False)
+    x = jnp.asarray(features_from_cells(d["inputs"][:3], d["outputs"][:3]))
+    h = jnp.moveaxis(x.astype(jnp.float32), -3, -1)
+    conv = params["conv_hidden"]
+    h = jax.nn.relu(jax.lax.conv_general_dilated(h.reshape(-1, *h.shape[2:]), conv["kernel"], (1, 1), "SAME",
+                                                 dimension_numbers=("NHWC", "HWIO", "NHWC")) + conv["bias"])
+    per_example = jax.nn.relu(h.max(axis=(1, 2)) @ params["dense_out"]["kernel"]).reshape(3, 10, -1)
+    by_hand = per_example.sum(axis=1) + params["bias"]
+    np.testing.assert_allclose(np.asarray(model.apply({"params": params}, x, jnp.ones((3, 10)))),
+                               np.asarray(by_hand), rtol=1e-5, atol=1e-5)
+    save(tmp_path / "p.msgpack", model, params)
+    m2, _, card = load(tmp_path / "p.msgpack")
+    assert card["model"]["pool"] == "hidden" and m2.pool == "hidden"
+    card["model"]["pool"] = "everywhere"
+    (tmp_path / "p.json").write_text(json.dumps(card))
+    with pytest.raises(DataFileError, match="pool 'everywhere'"):
+        load(tmp_path / "p.msgpack")
 
 
 def test_relu_evidence_lets_an_example_that_shows_nothing_say_nothing(tiny):
@@ -223,6 +273,9 @@ def test_predicted_arguments_keep_only_those_that_pass():
     assert lp["set_color_attn"][0] > lp["set_color_attn"][1]
     assert np.isinf(lp["fill_color"]).all()  # nothing passes: the instruction is left out
     assert lp["set_shape_attn"][0] == 0 and THRESHOLD == 0.55
+    higher = argument_logp(probs, threshold=0.6)  # a higher threshold: set_shape_attn left out, green kept
+    assert np.isinf(higher["set_shape_attn"]).all() and np.isfinite(higher["set_color_attn"][:2]).all()
+    assert np.isclose(np.exp(higher["set_color_attn"][:2]).sum(), 1)
 
 
 def test_shipped_weights_load_and_read_a_colour_change(capsys):

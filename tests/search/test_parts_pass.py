@@ -94,6 +94,28 @@ def test_a_resume_with_other_search_settings_is_still_refused(ds, tmp_path):
         _induce(ds, out, parts=2, epsilon=0.2)
 
 
+def test_a_run_recorded_before_the_argument_threshold_resumes_at_055_only(ds, tmp_path):
+    """run.json written before `arg_threshold` existed searched at the paper's 0.55: it
+    resumes with 0.55 and refuses another threshold (which would search otherwise)."""
+    out = tmp_path / "run"
+    _induce(ds, out, parts=1)
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["settings"].pop("arg_threshold") == 0.55
+    (out / "run.json").write_text(json.dumps(meta))
+    _induce(ds, out, parts=1)  # resumed: nothing to redo
+    with pytest.raises(DataFileError, match="other settings"):
+        _induce(ds, out, parts=1, arg_threshold=0.6)
+
+
+@pytest.mark.parametrize("option,value", [("--arg-threshold", "0"), ("--arg-threshold", "1.5"),
+                                          ("--arg-threshold", "high")])
+def test_a_bad_argument_threshold_is_one_line(tmp_path, capsys, option, value):
+    assert main(["induce", "--concepts", "demo", "--out", str(tmp_path / "r"), option, value]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and option in err[0]
+    assert not (tmp_path / "r").exists()
+
+
 @pytest.mark.parametrize("value", ["0", "4", "two"])
 def test_a_bad_parts_value_is_one_line(tmp_path, capsys, value):
     assert main(["induce", "--concepts", "demo", "--out", str(tmp_path / "r"), "--parts", value]) == 2

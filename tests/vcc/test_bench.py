@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from vcc.cli import build_parser, main
+from vccjax.errors import DataFileError
 
 
 def test_bench_search_compares_batched_and_scalar_on_the_same_concepts(tmp_path, capsys):
@@ -399,3 +402,12 @@ def test_bench_misses_names_the_cheapest_known_program_and_its_rank(tmp_path):
                                                  for p in (moves_nothing, shorter)))
     c = why_missed(tmp_path / "large", [tmp_path / "other"])["misses"][0]
     assert c["program"] == shorter and c["nats"] < b["nats"] and c["rank"] < b["rank"]
+    # any concept the run searched, found or not, ranked under a chosen model: the found one's
+    # reference program is shorter than the missed one's, so it ranks before it
+    both = why_missed(tmp_path / "large", model_index=0, concepts=[found, missed])
+    assert [r["concept"] for r in both["misses"]] == [found, missed] and both["model"] == "model-0.json"
+    assert both["misses"][0]["rank"] < both["misses"][1]["rank"] == b["rank"]
+    with pytest.raises(DataFileError, match="no model-3.json"):
+        why_missed(tmp_path / "large", model_index=3)
+    with pytest.raises(DataFileError, match="searched no concept remove_top_obj"):
+        why_missed(tmp_path / "large", concepts=["remove_top_obj"])
