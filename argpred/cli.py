@@ -33,12 +33,13 @@ def _commit() -> str | None:
 
 
 def _eval_command(weights: str | None = None, concepts: str = "all", dataset: str | None = None,
-                  out: str | None = None, record: bool = False) -> str:
+                  out: str | None = None, record: bool = False, threshold: float = 0.55) -> str:
     """The `vcc argpred eval` command line that measures this (options left at their
     defaults are left out)."""
     parts = ["vcc", "argpred", "eval"]
     for flag, value, default in (("--weights", weights, None), ("--concepts", concepts, "all"),
-                                 ("--dataset", dataset, None), ("--out", out, None)):
+                                 ("--dataset", dataset, None), ("--threshold", threshold, 0.55),
+                                 ("--out", out, None)):
         if value != default:
             parts += [flag, str(value)]
     return shlex.join(parts + (["--record"] if record else []))
@@ -123,17 +124,17 @@ def cmd_recall(a: argparse.Namespace) -> int:
     from vccjax.world.concepts import concept_list
 
     names = concept_list(a.concepts)
-    if a.record and (a.concepts != "all" or a.dataset):
-        raise ValueError("--record keeps the recall on all the concepts' shipped examples in the weights card: "
-                         "leave out --concepts and --dataset")
+    if a.record and (a.concepts != "all" or a.dataset or a.threshold != 0.55):
+        raise ValueError("--record keeps the recall on all the concepts' shipped examples at 0.55 in the weights "
+                         "card: leave out --concepts, --dataset and --threshold")
     start = time.time()
-    r, card = measure(a.weights, names, a.dataset)
+    r, card = measure(a.weights, names, a.dataset, a.threshold)
     seconds = time.time() - start
     date = _now()
     if a.out:
         _write_json(Path(a.out), {
             "benchmark": "argpred-recall", "date": date, "commit": _commit(),
-            "command": _eval_command(a.weights, a.concepts, a.dataset, a.out, a.record),
+            "command": _eval_command(a.weights, a.concepts, a.dataset, a.out, a.record, a.threshold),
             "weights": a.weights or "shipped", "weights_sha256": card["sha256"],
             "members": card["model"].get("members", 1), "dataset": a.dataset or "shipped", "split": "train",
             "seconds": round(seconds, 2), **r})
@@ -218,6 +219,9 @@ def add_commands(sub) -> None:
     e.add_argument("--concepts", type=runtime.name_list, default="all",
                    help="'all' (default), 'demo' or a comma-separated list")
     e.add_argument("--dataset", help="dataset folder (default: the shipped one)")
+    e.add_argument("--threshold", type=runtime.number(0, 1, above=True), default=0.55,
+                   help="an argument passes at this probability (default 0.55, the paper's; what `vcc induce "
+                        "--arg-threshold` searches with)")
     e.add_argument("--out", "--json", dest="out", type=runtime.out_file(".json"),
                    help="write the result JSON here: recall, concepts recalled, misses, mean extra arguments "
                         "per function, the weights' sha256, date, commit and command")

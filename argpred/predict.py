@@ -61,6 +61,6 @@ def default_predictor() -> Predictor:
     return Predictor()
 
 
-def passing(probs: dict[str, np.ndarray]) -> dict[str, list[str]]:
-    return {f: [v for v, q in zip(arg_domain(f), p) if q >= THRESHOLD] for f, p in probs.items()}
+def passing(probs: dict[str, np.ndarray], threshold: float = THRESHOLD) -> dict[str, list[str]]:
+    return {f: [v for v, q in zip(arg_domain(f), p) if q >= threshold] for f, p in probs.items()}
 

@@ -27,11 +27,11 @@ def used_arguments(concept: str) -> dict[str, set[str]]:
 
 
 def recall(predictor: Predictor, concepts: Sequence[str],
-           pairs: Callable[[str], list[tuple[Scene, Scene]]]) -> dict:
+           pairs: Callable[[str], list[tuple[Scene, Scene]]], threshold: float = THRESHOLD) -> dict:
     missed: dict[str, dict[str, list[str]]] = {}
     extra = {f: [] for f in PREDICTED}
     for c in concepts:
-        ok = passing(predictor.for_pairs(pairs(c)))
+        ok = passing(predictor.for_pairs(pairs(c)), threshold)
         used = used_arguments(c)
         miss = {f: sorted(used[f] - set(ok[f])) for f in PREDICTED if used[f] - set(ok[f])}
         if miss:
@@ -39,17 +39,18 @@ def recall(predictor: Predictor, concepts: Sequence[str],
         for f in PREDICTED:
             extra[f].append(len(set(ok[f]) - used[f]))
     return {
-        "concepts": len(concepts), "recalled": len(concepts) - len(missed),
+        "concepts": len(concepts), "threshold": threshold, "recalled": len(concepts) - len(missed),
         "recall": (len(concepts) - len(missed)) / len(concepts),
         "mean_extra_arguments": {f: float(np.mean(v)) for f, v in extra.items()},
         "missed": missed,
     }
 
 
-def measure(weights=None, concepts: Sequence[str] | None = None, dataset=None) -> tuple[dict, dict]:
+def measure(weights=None, concepts: Sequence[str] | None = None, dataset=None,
+            threshold: float = THRESHOLD) -> tuple[dict, dict]:
     """(`recall` of the weights at `weights` (default: the shipped ones) on `concepts`
     (default: all 546) with the training pairs of `dataset` (default: the shipped
-    examples), the weights' card)."""
+    examples) at `threshold`, the weights' card)."""
     from vccjax.world.concepts import concept_names
     from vccjax.world.dataset import dataset_for
 
@@ -58,7 +59,7 @@ def measure(weights=None, concepts: Sequence[str] | None = None, dataset=None) -
         raise ValueError("no concepts to measure recall on")
     predictor = Predictor(weights)
     ds = dataset_for(names, 0, dataset, progress=False)
-    return recall(predictor, names, lambda c: ds.pairs(c, "train")), predictor.card
+    return recall(predictor, names, lambda c: ds.pairs(c, "train"), threshold), predictor.card
 
 
 def card_record(r: dict, date: str, command: str) -> dict:

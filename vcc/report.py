@@ -304,15 +304,16 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
     if not runs:
         return []
     lines = ["## Argument predictor: recall and extra arguments (`vcc argpred eval`)", "",
-             "| file | weights | concepts (split) | recalled: every used argument passes | "
-             "mean extra arguments per concept, by function | not recalled |", "|---|---|---|---|---|---|"]
+             "| file | weights | concepts (split) | threshold | recalled: every used argument passes | "
+             "mean extra arguments per concept, by function | not recalled |", "|---|---|---|---|---|---|---|"]
     for name, d in runs:
         n = d["concepts"] if isinstance(d["concepts"], int) else len(d["concepts"])
         extra = ", ".join(f"{f} {v:.2f}" for f, v in d["mean_extra_arguments"].items())
         missed = "; ".join(f"{c}: " + ", ".join(f"{f}({', '.join(v)})" for f, v in fs.items())
                            for c, fs in d["missed"].items()) or "none"
         lines.append(f"| `{name}` | {d['weights']} `{d['weights_sha256'][:8]}` ({d['members']} networks) | "
-                     f"{n} ({d['split']}) | {d['recalled']} ({d['recall']:.1%}) | {extra} | {missed} |")
+                     f"{n} ({d['split']}) | {d.get('threshold', 0.55):g} | {d['recalled']} ({d['recall']:.1%}) | {extra} | "
+                     f"{missed} |")
     return lines + [""] + [f"- `{n}`: {d.get('date', '?')}, commit {d.get('commit', '?')}; command "
                            f"`{d.get('command', '?')}`" for n, d in runs] + [""]
 

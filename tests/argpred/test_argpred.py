@@ -363,6 +363,24 @@ def _one_error_line(capsys, fragment: str) -> None:
     assert err.startswith("vcc") and ": error: " in err and err.count("\n") == 1 and fragment in err, err
 
 
+def test_a_higher_threshold_passes_fewer_arguments(tmp_path):
+    """Recall and extra arguments at two thresholds, on a few concepts: every argument
+    passing 0.6 passes 0.55, so 0.6 recalls no concept 0.55 misses and passes no more
+    extra arguments; the result file says which threshold it measured."""
+    from vcc.cli import main
+
+    concepts = "change_all_objs_color,move_all_objs_down,change_red_objs_color,remove_bottom_obj,move_to_top_edge"
+    runs = {}
+    for t in ("0.55", "0.6"):
+        out = tmp_path / f"r{t}.json"
+        assert main(["argpred", "eval", "--concepts", concepts, "--threshold", t, "--out", str(out), "--show", "0"]) == 0
+        runs[t] = json.loads(out.read_text())
+        assert runs[t]["threshold"] == float(t) and ("--threshold" in runs[t]["command"]) == (t != "0.55")
+    low, high = runs["0.55"], runs["0.6"]
+    assert set(low["missed"]) <= set(high["missed"]) and high["recalled"] <= low["recalled"]
+    assert all(high["mean_extra_arguments"][f] <= v for f, v in low["mean_extra_arguments"].items())
+
+
 def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_path, capsys, monkeypatch):
     from argpred import cli as argcli
     from vcc.cli import main
@@ -381,6 +399,8 @@ def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_pat
         (train + ["--programs", "0"], "argument --programs: 0 is out of range"),
         (train + ["--joined", "1.5"], "argument --joined: 1.5 is out of range"),
         (train + ["--carry", "-1"], "argument --carry: -1 is out of range"),
+        (train + ["--loops", "-1"], "argument --loops: -1 is out of range"),
+        (train + ["--pool", "everywhere"], "argument --pool: invalid choice"),
         (["argpred", "train", "--out", str(tmp_path), "--quiet"], "write .msgpack"),
         (["argpred", "data", "--out", str(d), "--programs", "0"], "argument --programs: 0 is out of range"),
         (["argpred", "data", "--out", str(d), "--joined", "nan"], "argument --joined: nan is not a finite number"),
@@ -388,6 +408,9 @@ def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_pat
         (["argpred", "eval", "--concepts", "no_such", "--out", str(res)], "unknown concept(s): no_such"),
         (["argpred", "eval", "--show", "-1", "--out", str(res)], "argument --show: -1 is out of range"),
         (["argpred", "eval", "--record", "--concepts", "remove_bottom_obj"], "--record keeps the recall on all"),
+        (["argpred", "eval", "--record", "--threshold", "0.6"], "--record keeps the recall on all"),
+        (["argpred", "eval", "--threshold", "0", "--out", str(res)], "argument --threshold: 0 is out of range"),
+        (["argpred", "data", "--out", str(d), "--kind", "loops"], "argument --kind: invalid choice"),
         (["argpred", "eval", "--weights", str(tmp_path / "none.msgpack"), "--out", str(res)], "none.msgpack: missing"),
     ]:
         assert main(argv) == 2, argv

@@ -274,6 +274,10 @@ def test_the_report_gives_the_predictors_recall_and_extra_arguments():
     row = next(x for x in lines if x.startswith("| `argpred-recall.json`"))
     assert f"| 6 ({6 / 8:.1%}) |" in row and "set_shape_attn 0.50, fill_color 1.25" in row
     assert "c1: fill_color(red, blue)" in row and "`01234567`" in row
+    assert "| 0.55 | 6 (" in row  # a file written before the threshold was recorded: the paper's 0.55
+    higher = next(x for x in argpred_section([("argpred-recall-0.6.json", {**d, "threshold": 0.6})])
+                  if x.startswith("| `argpred-recall-0.6.json`"))
+    assert "| 0.6 | 6 (" in higher
     assert argpred_section([]) == []
 
 
