@@ -6,12 +6,12 @@ The concepts being searched have their example scenes and targets in a bank of
 number of concepts); a batch's rows are programs, each reading its concept's slot.
 On the host a prefix's states are one packed int32 row per example (`search.packing`),
 so a frame is one array and a transfer one copy. A request's children are stepped
-atom by atom (a subroutine is several): each atom's rows sorted by instruction into
-chunks of a few rows of one instruction, all chunks run in one device call
-(`stepping.step_chunks`, a switch per chunk), so a round makes one call where it made
-one per instruction, and one function compiles where one per instruction did. A
-closed loop's further iterations are replayed in one device call per piece of rows
-(`_replay_loops`). Complete programs are judged on the device.
+atom by atom (a subroutine is several): all of an atom's rows, whatever their
+instruction, and the further iterations of the loops they close run in one device call
+per piece of rows (`stepping.advance`: rows of one instruction taken a few at a time
+through one switch), so a round makes one call where it made one per instruction, and
+one function compiles where one per instruction (and again for the replay) did.
+Complete programs are judged on the device.
 
 This module is the only part of the search that reads the machine state's fields
 (the section "the machine state's fields" below).
@@ -27,17 +27,15 @@ import jax.numpy as jnp
 import numpy as np
 
 from search.backend import Reply, Request
-from search.device_calls import BUCKETS, DeviceCalls, Pending
-from search.packing import blackboard_columns, pack_state, packed_field, unpack_blackboard, unpack_state
-from search.stepping import EMPTY_HANDED, STEP_CHUNK, replay_loops, step_chunks
+from search.device_calls import BUCKETS, DeviceCalls
+from search.packing import blackboard_columns, pack_state, unpack_blackboard, unpack_state
+from search.stepping import advance
 from search.task import Task
 
-# One batch size each for the fused step and the replay: their cost follows the rows they
-# run, not the padding (only copied), so one compile each serves every round.
+# One batch size for the step (with its replay): its cost follows the rows it runs, not
+# the padding (only copied), so one compile serves every round.
 STEP_ROWS = (256,)
-REPLAY_ROWS = (64,)
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.machine.instructions import OP
 from vccjax.machine.match import ASK, YES, Target, verdict
 from vccjax.machine.scene import scenes_match
 from vccjax.machine.state import SceneConst, VCCState, init_state, output_scene
@@ -47,16 +45,6 @@ from vccjax.machine.state import SceneConst, VCCState, init_state, output_scene
 def _failed_anywhere(states: VCCState) -> jax.Array:
     """(B,) whether each program of (B, E) states failed on some example (traced)."""
     return jnp.any(states.control.failed, axis=1)
-
-
-def _failed_rows(packed: np.ndarray, rows: np.ndarray, cfg: VCCConfig) -> np.ndarray:
-    """(len(rows),) whether packed rows `rows` failed on some example."""
-    return packed_field(packed, "control.failed", cfg)[rows].any(axis=1)
-
-
-def _holding_rows(packed: np.ndarray, rows: np.ndarray, cfg: VCCConfig) -> np.ndarray:
-    """(len(rows),) whether some example of packed rows `rows` holds an object."""
-    return (packed_field(packed, "hand.held", cfg)[rows] >= 0).any(axis=1)
 
 
 def _blackboards(packed: np.ndarray, cfg: VCCConfig) -> np.ndarray:
@@ -77,19 +65,11 @@ def _device_verdicts(cfg: VCCConfig, consts: SceneConst, targets: Target, slots,
 
 
 @functools.partial(jax.jit, static_argnums=0)
-def _advance_chunks(cfg: VCCConfig, consts: SceneConst, slots, packed, row_ops, args, real):
-    """`step_chunks` on packed states: rows come in chunks of `STEP_CHUNK` of one op
-    (`row_ops`, one per row), the chunks holding the first `real` rows run; return the
-    states and whether each program failed on any example."""
-    n_chunks = (real + STEP_CHUNK - 1) // STEP_CHUNK
-    new = step_chunks(cfg, consts, slots, unpack_state(packed, cfg), row_ops[::STEP_CHUNK], args, n_chunks)
+def _advance_packed(cfg: VCCConfig, consts: SceneConst, slots, packed, ops, args, real):
+    """`stepping.advance` on packed states, the first `real` rows; return the states and
+    whether each program failed on any example."""
+    new = advance(cfg, consts, slots, unpack_state(packed, cfg), ops, args, real)
     return pack_state(new, cfg), _failed_anywhere(new)
-
-
-@functools.partial(jax.jit, static_argnums=0)
-def _replay_packed(cfg: VCCConfig, consts: SceneConst, slots, packed, real):
-    """`replay_loops` on packed states, the first `real` rows."""
-    return pack_state(replay_loops(cfg, consts, slots, unpack_state(packed, cfg), real), cfg)
 
 
 @functools.lru_cache(maxsize=None)
@@ -196,52 +176,21 @@ class JaxBackend:
     def _step_atoms(self, ops: np.ndarray, args: np.ndarray, slots: np.ndarray, source: np.ndarray,
                     source_row: np.ndarray, children: np.ndarray, failed: np.ndarray) -> None:
         """Step each child not yet failed by its atom `ops[i]` (none where -1), from state
-        `source[source_row[i]]` into `children[i]`; mark `failed` (both in place). The rows
-        are sorted by op (a carry op's holders apart) into chunks of `STEP_CHUNK` rows of
-        one op, and all the chunks run in one device call per piece of `STEP_ROWS` rows."""
+        `source[source_row[i]]` into `children[i]`, a closed loop's further iterations
+        included; mark `failed` (both in place). One device call per piece of `STEP_ROWS`
+        rows (`stepping.advance`)."""
         rows = np.nonzero((ops >= 0) & ~failed)[0]
         if len(rows) == 0:
             return
-        op_of = ops[rows]
-        carry = np.isin(op_of, list(EMPTY_HANDED))
-        holds = np.zeros(len(rows), bool)
-        if carry.any():
-            holds[carry] = _holding_rows(source, source_row[rows[carry]], self.cfg)
-        key = 2 * op_of + holds
-        order = np.argsort(key, kind="stable")
-        rows, key = rows[order], key[order]
-        starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
-        counts = np.diff(np.r_[starts, len(rows)])
-        padded = -(-counts // STEP_CHUNK) * STEP_CHUNK  # each op's rows to whole chunks, repeating its last
-        at = np.repeat(starts, padded) + np.minimum(
-            np.arange(padded.sum()) - np.repeat(np.cumsum(padded) - padded, padded), np.repeat(counts - 1, padded))
-        batch, row_ops = rows[at], ops[rows[at]]
-        real = at != np.r_[-1, at[:-1]]  # the first occurrence of each row: the others are padding
         cfg, (consts, _) = self.cfg, self._bank
         pending = self.calls.start(
-            ("chunks", source.shape[1]), np.arange(len(batch)),
-            lambda rows_of: _advance_chunks(cfg, consts, rows_of(slots, batch), rows_of(source, source_row[batch]),
-                                            rows_of(row_ops), rows_of(args, batch), rows_of.real),
+            ("advance", source.shape[1]), rows,
+            lambda rows_of: _advance_packed(cfg, consts, rows_of(slots), rows_of(source, source_row),
+                                            rows_of(ops), rows_of(args), rows_of.real),
             STEP_ROWS)
         for piece, (new, fails) in self.calls.results(pending):
-            keep = real[piece]
-            children[batch[piece[keep]]] = new[keep]
-            failed[batch[piece[keep]]] |= fails[keep]
-        closed = rows[ops[rows] == OP["loop_end"]]
-        if len(closed):
-            closed = closed[~failed[closed]]
-            self._replay_loops(slots, children, closed)
-            failed[closed] |= _failed_rows(children, closed, self.cfg)
-
-    def _replay_loops(self, slots: np.ndarray, states: np.ndarray, rows: np.ndarray) -> None:
-        """A closed loop's remaining iterations for `states[rows]` (in place), each piece of
-        rows in one device call (`stepping.replay_loops`)."""
-        cfg, (consts, _) = self.cfg, self._bank
-        for done_rows, new in self.calls.run(
-                ("replay", states.shape[1]), rows,
-                lambda rows_of: _replay_packed(cfg, consts, rows_of(slots), rows_of(states), rows_of.real),
-                REPLAY_ROWS):
-            states[done_rows] = new
+            children[piece] = new
+            failed[piece] |= fails
 
     def _children_room(self, shape: tuple, dtype) -> np.ndarray:
         """Room for a round's children, reused from round to round (a fresh array each round

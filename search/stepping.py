@@ -1,11 +1,12 @@
 """The search's batched stepping: many programs of many concepts, each on its concept's
 example scenes, stepped by one static instruction per device call.
 
-A search holds (B, E) states, B programs times E examples; `step_examples` steps them
-all by one op. Loops: with replay=False a `loop_end` only closes the loop and the
-caller replays its body with `replay_loops`: every further iteration in one device
-call, each body instruction run by its own code only (`replay_examples`), instead of
-tracing every instruction's code per row.
+A search holds (B, E) states, B programs times E examples. `advance` steps each row by
+its own instruction and replays the loops closed, in one device call through one
+switch over the instructions (what the search runs). `step_examples` steps all rows by
+one static op; with replay=False a `loop_end` only closes the loop and `replay_loops`
+runs every further iteration in one call, each body instruction by its own code only
+(`replay_examples`): the emulator benchmark's per-instruction calls.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from vccjax.machine.config import VCCConfig
 from vccjax.machine.instructions import OP
 from vccjax.machine.ops import hand_to_attended, select
 from vccjax.machine.state import SceneConst, VCCState
-from vccjax.machine.step import execute, step_op
+from vccjax.machine.step import after_op, before_op, execute, step_op
 
 
 def _fails_empty_handed(cfg, c, s, arg):
@@ -186,30 +187,82 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
                               (jnp.int32(1), states))[1]
 
 
-STEP_CHUNK = 4  # rows of one instruction a fused step runs at a time
+ADVANCE_CHUNK = 4  # rows of one instruction `advance` runs at a time
 
 
 @functools.partial(jax.jit, static_argnums=0)
-def step_chunks(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState, chunk_ops: jax.Array,
-                args: jax.Array, n_chunks: jax.Array) -> VCCState:
-    """Step (B, E) states whose rows come in chunks of `STEP_CHUNK` rows of one op each
-    (`chunk_ops`, (B // STEP_CHUNK,)), the first `n_chunks` chunks only, in one device
-    call: per chunk a switch on an unbatched index runs that op's code (`step_examples`;
-    a `loop_end` only closes the loop, its further iterations are `replay_loops`')."""
-    size = STEP_CHUNK
+def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState, ops: jax.Array,
+            args: jax.Array, real: jax.Array) -> VCCState:
+    """Step row b of (B, E) states by its own instruction (`ops[b]`, `args[b]`), then run
+    every further iteration of the loops that step closed, all in one device call with
+    one switch over the instructions (so each instruction's code is compiled once, not
+    once for the step and once for the replay). Rows from `real` on are padding: left as
+    they came.
+
+    The step is iteration 0 of the replay's loop: at each position (one for the step,
+    the body's for a replay) the rows that run there are taken `ADVANCE_CHUNK` at a time,
+    rows of one instruction together (of a carry instruction, rows that hold an object
+    apart), and run by that instruction's code only: in the step with its bookkeeping
+    (`before_op`, `after_op`; a `loop_end` only closes the loop), in a replay on the
+    examples still looping (as `replay_examples`). A program that failed on some
+    example is dead: its loop is not replayed further."""
+    rows, size = ops.shape[0], min(ADVANCE_CHUNK, ops.shape[0])
+    padding = jnp.arange(rows) >= real
+    closed = (ops == OP["loop_end"]) & ~padding
+    carries = jnp.asarray([op in EMPTY_HANDED for op in range(len(OP))])
 
     def branch(op):
-        def run(c_tasks, s, a):
-            return step_examples(cfg, op, consts, c_tasks, s, a, op != OP["loop_end"])
+        def run(s, at, arg, pc, active, is_step):
+            def per_program(fn):
+                def one(c, s, arg, pc, act):
+                    s1, step_pc = before_op(cfg, s, op, arg)
+                    ran = execute(cfg, c, select(is_step, s1, s), op, arg, jnp.where(is_step, step_pc, pc), fn)
+                    return select(is_step, after_op(cfg, s, s1, ran, op), select(act & ~s.control.failed, ran, s))
+
+                return _per_task(consts, one, (None, None, 0))
+
+            stepped = jnp.where(is_step, True, active & ~s.control.failed)
+            return _batched(cfg, op, per_program, tasks[at], s, arg, pc, active, stepped=stepped)
         return run
 
     branches = [branch(op) for op in range(len(OP))]
 
-    def chunk(i, s):
-        start = i * size
-        part = jax.tree.map(lambda a: jax.lax.dynamic_slice_in_dim(a, start, size), s)
-        new = jax.lax.switch(chunk_ops[i], branches, jax.lax.dynamic_slice_in_dim(tasks, start, size), part,
-                             jax.lax.dynamic_slice_in_dim(args, start, size))
-        return jax.tree.map(lambda a, b: jax.lax.dynamic_update_slice_in_dim(a, b, start, 0), s, new)
+    def alive(s, it):
+        dead = jnp.any(s.control.failed, axis=1) | ~closed
+        return loop_needs_iteration(cfg, s, it) & ~dead[:, None]
 
-    return jax.lax.fori_loop(0, n_chunks, chunk, states)
+    def iterate(carry):
+        it, s = carry
+        is_step = it == 0
+        active = jnp.where(is_step, ~padding[:, None], alive(s, it))  # (B, E), fixed for this iteration
+        live_rows = active.any(axis=1)
+        ctl = s.control  # a body is the same on every example; the step may just have closed it
+        body_ops, body_args = ctl.body_ops[:, 0], ctl.body_args[:, 0]
+        length, pc0 = jnp.where(is_step, 1, ctl.body_len[:, 0]), ctl.body_pc0[:, 0]
+
+        def position(j, s):
+            op_here = jnp.where(is_step, ops, body_ops[:, j])
+            arg_here = jnp.where(is_step, args, body_args[:, j])
+            holds = jnp.any((s.hand.held >= 0) & active, axis=1)
+            key = 2 * op_here + (holds & carries[op_here])
+
+            def chunk(carry):  # up to `size` pending rows of the least key
+                s, pending = carry
+                k = jnp.min(jnp.where(pending, key, 2 * len(OP)))
+                at = jnp.nonzero(pending & (key == k), size=size, fill_value=rows)[0]
+                taken = at < rows
+                safe = jnp.minimum(at, rows - 1)
+                sub = jax.tree.map(lambda a: a[safe], s)
+                sub = jax.lax.switch(k // 2, branches, sub, safe, arg_here[safe], pc0[safe] + j,
+                                     active[safe] & taken[:, None], is_step)
+                s = jax.tree.map(lambda a, b: a.at[at].set(b, mode="drop"), s, sub)
+                return s, pending.at[at].set(False, mode="drop")
+
+            pending = live_rows & (length > j)
+            return jax.lax.while_loop(lambda carry: jnp.any(carry[1]), chunk, (s, pending))[0]
+
+        steps = jnp.max(jnp.where(live_rows, length, 0))
+        return it + 1, jax.lax.fori_loop(0, steps, position, s)
+
+    return jax.lax.while_loop(lambda carry: (carry[0] == 0) | jnp.any(alive(carry[1], carry[0])), iterate,
+                              (jnp.int32(0), states))[1]

@@ -87,30 +87,48 @@ def _replay(cfg: VCCConfig, c: SceneConst, s: VCCState, active) -> VCCState:
     return s
 
 
+def before_op(cfg: VCCConfig, s: VCCState, op, arg) -> tuple[VCCState, jax.Array]:
+    """The bookkeeping before a program instruction runs (docs/vcc.md section 5): the
+    program counter advanced and, in an open loop, the instruction recorded in the body.
+    Returns that state and the instruction's program index."""
+    op = jnp.asarray(op, jnp.int32)
+    ctl = s.control
+    recording = ctl.in_loop & (op != OP["loop_end"])
+    slot = jnp.minimum(ctl.body_len, cfg.body_max - 1)
+    return s.replace(control=ctl.replace(
+        pc=ctl.pc + 1,
+        body_ops=jnp.where(recording, ctl.body_ops.at[slot].set(op), ctl.body_ops),
+        body_args=jnp.where(recording, ctl.body_args.at[slot].set(arg), ctl.body_args),
+        body_len=ctl.body_len + recording,
+    )), ctl.pc
+
+
+def after_op(cfg: VCCConfig, s: VCCState, s1: VCCState, ran: VCCState, op) -> VCCState:
+    """What a program instruction leaves, given the state `s` before it, `s1` from
+    `before_op` and `ran`, the instruction run on `s1`: a forbidden or overlong body
+    instruction fails, one in a zero-iteration loop is only recorded, and a state that
+    had failed (or padding, op -1) stays as it was."""
+    op = jnp.asarray(op, jnp.int32)
+    ctl = s.control
+    recording = ctl.in_loop & (op != OP["loop_end"])
+    bad = recording & (jnp.any(op == _FORBIDDEN) | (ctl.body_len >= cfg.body_max))
+    skipped = recording & ~ctl.loop_active  # a zero-iteration loop only records its body
+    out = select(skipped, s1, ran)
+    out = select(bad, _commit(s1, s1, True, ctl.pc), out)
+    return select(ctl.failed | (op < 0), s, out)
+
+
 def _step(cfg: VCCConfig, c: SceneConst, s: VCCState, op, arg, run_op, replay: bool = True) -> VCCState:
     """Loop bookkeeping (docs/vcc.md section 5) around one instruction; `op` static or traced.
     replay=False leaves a closed loop's remaining iterations to the caller (the search
     replays them one static instruction at a time)."""
     may_end_loop = (not isinstance(op, int) or op == OP["loop_end"]) and replay
-    op = jnp.asarray(op, jnp.int32)
-    ctl = s.control
-    pc = ctl.pc
-    recording = ctl.in_loop & (op != OP["loop_end"])
-    bad = recording & (jnp.any(op == _FORBIDDEN) | (ctl.body_len >= cfg.body_max))
-    slot = jnp.minimum(ctl.body_len, cfg.body_max - 1)
-    s1 = s.replace(control=ctl.replace(
-        pc=pc + 1,
-        body_ops=jnp.where(recording, ctl.body_ops.at[slot].set(op), ctl.body_ops),
-        body_args=jnp.where(recording, ctl.body_args.at[slot].set(arg), ctl.body_args),
-        body_len=ctl.body_len + recording,
-    ))
+    s1, pc = before_op(cfg, s, op, arg)
     ran = run_op(c, s1, arg, pc)
     if may_end_loop:
-        ran = _replay(cfg, c, ran, (op == OP["loop_end"]) & ~recording)
-    skipped = recording & ~ctl.loop_active  # a zero-iteration loop only records its body
-    out = select(skipped, s1, ran)
-    out = select(bad, _commit(s1, s1, True, pc), out)
-    return select(ctl.failed | (op < 0), s, out)
+        recording = s.control.in_loop & (jnp.asarray(op, jnp.int32) != OP["loop_end"])
+        ran = _replay(cfg, c, ran, (jnp.asarray(op, jnp.int32) == OP["loop_end"]) & ~recording)
+    return after_op(cfg, s, s1, ran, op)
 
 
 def step(cfg: VCCConfig, c: SceneConst, s: VCCState, op, arg) -> VCCState:
