@@ -211,21 +211,27 @@ def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCSta
     closed = (ops == OP["loop_end"]) & ~padding
     carries = jnp.asarray([op in EMPTY_HANDED for op in range(len(OP))])
 
-    def branch(op):
-        def run(s, at, arg, pc, active, is_step):
+    def branch(op):  # the instruction's own code only: the bookkeeping is op-generic, outside the switch
+        def run(s, at, arg, pc, stepped):
             def per_program(fn):
-                def one(c, s, arg, pc, act):
-                    s1, step_pc = before_op(cfg, s, op, arg)
-                    ran = execute(cfg, c, select(is_step, s1, s), op, arg, jnp.where(is_step, step_pc, pc), fn)
-                    return select(is_step, after_op(cfg, s, s1, ran, op), select(act & ~s.control.failed, ran, s))
+                return _per_task(consts, lambda c, s, arg, pc: execute(cfg, c, s, op, arg, pc, fn), (None, 0))
 
-                return _per_task(consts, one, (None, None, 0))
-
-            stepped = jnp.where(is_step, True, active & ~s.control.failed)
-            return _batched(cfg, op, per_program, tasks[at], s, arg, pc, active, stepped=stepped)
+            return _batched(cfg, op, per_program, tasks[at], s, arg, pc, stepped=stepped)
         return run
 
     branches = [branch(op) for op in range(len(OP))]
+    per_example = functools.partial(jax.vmap, in_axes=(0, None))  # over a row's examples, one value per row
+
+    def run_chunk(sub, op, at, arg, pc, active, is_step):
+        """Rows `sub` (all of one instruction `op`, traced) stepped, or replayed at `pc`
+        where `active`."""
+        s1, step_pc = jax.vmap(per_example(lambda s, a: before_op(cfg, s, op, a)))(sub, arg)
+        stepped = jnp.where(is_step, True, active & ~sub.control.failed)
+        ran = jax.lax.switch(op, branches, select(is_step, s1, sub), at, arg,
+                             jnp.where(is_step, step_pc, pc[:, None]), stepped)
+        after = jax.vmap(jax.vmap(lambda s, s1, r: after_op(cfg, s, s1, r, op)))(sub, s1, ran)
+        replayed = jax.vmap(jax.vmap(select))(active & ~sub.control.failed, ran, sub)  # per example
+        return select(is_step, after, replayed)
 
     def alive(s, it):
         dead = jnp.any(s.control.failed, axis=1) | ~closed
@@ -252,9 +258,8 @@ def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCSta
                 at = jnp.nonzero(pending & (key == k), size=size, fill_value=rows)[0]
                 taken = at < rows
                 safe = jnp.minimum(at, rows - 1)
-                sub = jax.tree.map(lambda a: a[safe], s)
-                sub = jax.lax.switch(k // 2, branches, sub, safe, arg_here[safe], pc0[safe] + j,
-                                     active[safe] & taken[:, None], is_step)
+                sub = run_chunk(jax.tree.map(lambda a: a[safe], s), k // 2, safe, arg_here[safe], pc0[safe] + j,
+                                active[safe] & taken[:, None], is_step)
                 s = jax.tree.map(lambda a, b: a.at[at].set(b, mode="drop"), s, sub)
                 return s, pending.at[at].set(False, mode="drop")
 
