@@ -296,6 +296,9 @@ def learn_section(results: list[tuple[str, dict]]) -> list[str]:
     return lines + [""]
 
 
+MISSES_SHOWN = 8  # concepts a predictor misses, named in its row (the file lists them all)
+
+
 def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
     """The argument predictor's recall and sharpness (`vcc argpred eval`): concepts whose
     used arguments all pass the threshold, and the arguments passed that a concept never
@@ -309,8 +312,11 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
     for name, d in runs:
         n = d["concepts"] if isinstance(d["concepts"], int) else len(d["concepts"])
         extra = ", ".join(f"{f} {v:.2f}" for f, v in d["mean_extra_arguments"].items())
+        shown = list(d["missed"].items())[:MISSES_SHOWN]
         missed = "; ".join(f"{c}: " + ", ".join(f"{f}({', '.join(v)})" for f, v in fs.items())
-                           for c, fs in d["missed"].items()) or "none"
+                           for c, fs in shown) or "none"
+        if len(d["missed"]) > len(shown):
+            missed += f"; and {len(d['missed']) - len(shown)} more (in the file)"
         lines.append(f"| `{name}` | {d['weights']} `{d['weights_sha256'][:8]}` ({d['members']} networks) | "
                      f"{n} ({d['split']}) | {d.get('threshold', 0.55):g} | {d['recalled']} ({d['recall']:.1%}) | {extra} | "
                      f"{missed} |")
