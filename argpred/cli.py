@@ -69,6 +69,8 @@ def cmd_train(a: argparse.Namespace) -> int:
     from argpred.weights import record, save
 
     out = Path(a.out)
+    if a.pool == "hidden" and not a.hidden:
+        raise ValueError("--pool hidden pools the hidden channels: give --hidden above 0")
     if out.is_dir():
         raise ValueError(f"--out {out}: a folder; give the weights file to write")
     start = time.time()
@@ -142,7 +144,7 @@ def cmd_recall(a: argparse.Namespace) -> int:
         record(a.weights, recall=card_record(r, date, _eval_command(a.weights)))
     for c, miss in list(r["missed"].items())[: a.show]:
         print(f"missed  {c}: " + "; ".join(f"{f}({', '.join(v)})" for f, v in miss.items()))
-    print("mean extra arguments per function: "
+    print(f"mean extra arguments per function at threshold {a.threshold:g}: "
           + ", ".join(f"{f} {v:.2f}" for f, v in r["mean_extra_arguments"].items()))
     print(f"weights sha256 {card['sha256']}; {r['concepts']} concepts in {seconds:.1f} s"
           + (f"; result: {a.out}" if a.out else "") + ("; recorded in the weights card" if a.record else ""))

@@ -260,7 +260,7 @@ def build_shard(seed: int, shard: int, size: int = SHARD, joined: float = 0.0,
                 kind: str = "drawn") -> dict[str, np.ndarray]:
     """`joined`: the share of programs drawn as two parts joined by reset_attn (0 keeps
     the draws of the shipped weights' data byte for byte); `kind="carry"`: carry
-    programs (`carry_program`) instead."""
+    programs (`carry_program`) instead, `kind="loop"`: loop programs (`loop_program`)."""
     if kind == "carry":
         key = [seed, shard, 0xCA77]
     elif kind == "loop":

@@ -127,8 +127,8 @@ class JaxBackend:
         self._load(next(k for k in range(self.width) if k not in used), task)
 
     def apply_many(self, requests: Sequence[Request]) -> list[Reply]:
-        """Every request's children stepped together: one group per instruction across all
-        requests, atom by atom; then the children that may end judged together."""
+        """Every request's children stepped together, atom by atom (each atom's rows in one
+        call whatever their instructions); then the children that may end judged together."""
         sizes = [len(r.portions) for r in requests]
         bounds = np.cumsum([0] + sizes)
         owner = np.repeat(np.arange(len(requests)), sizes)  # (n,) the request of each child

@@ -1,5 +1,5 @@
 """The search's batched stepping: many programs of many concepts, each on its concept's
-example scenes, stepped by one static instruction per device call.
+example scenes, stepped together on the device.
 
 A search holds (B, E) states, B programs times E examples. `advance` steps each row by
 its own instruction and replays the loops closed, in one device call through one
@@ -44,7 +44,8 @@ def holding_split(op: int, rows: np.ndarray, holding: np.ndarray,
     """`rows` split into those where some example holds an object (`holding`, one bool per
     row) and the rest, for a carry op (the rest then skip the carry: `EMPTY_HANDED`),
     when that makes the carrying calls smaller: padded to the same sizes, the split
-    would only add a call. Shared by the search and the emulator benchmark."""
+    would only add a call (the emulator benchmark's per-instruction calls; `advance`
+    groups a carry op's holders apart on the device)."""
     if op not in EMPTY_HANDED or sum(piece_sizes(int(holding.sum()))) >= sum(piece_sizes(len(rows))):
         return [rows]
     return [part for part in (rows[holding], rows[~holding]) if len(part)]
@@ -115,11 +116,8 @@ def replay_examples(cfg: VCCConfig, op: int, consts: SceneConst, tasks: jax.Arra
     return _batched(cfg, op, per_program, tasks, states, args, pcs, active, stepped=active & ~states.control.failed)
 
 
-BODY_OPS = OP["loop_start"]  # ops 0 .. BODY_OPS - 1 may be recorded in a loop body (docs/vcc.md section 5)
-
-
 REPLAY_CHUNK = 4  # rows a replayed instruction runs on at a time
-_CARRIES = np.array([op in EMPTY_HANDED for op in range(BODY_OPS)])  # body ops whose cost is the carry
+_CARRIES = np.array([op in EMPTY_HANDED for op in range(len(OP))])  # ops whose cost is the carry
 
 
 @functools.partial(jax.jit, static_argnums=0)
@@ -148,7 +146,7 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
             return replay_examples(cfg, op, consts, tasks[at], s, args[at, j], pc0[at] + j, active)
         return run
 
-    branches = [branch(op) for op in range(BODY_OPS)]
+    branches = [branch(op) for op in range(len(OP))]  # any instruction a body may record
 
     padding = jnp.arange(rows) >= (rows if real is None else real)
 
@@ -162,13 +160,13 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
         live_rows = active.any(axis=1)
 
         def position(j, s):
-            op_here = jnp.minimum(ops[:, j], BODY_OPS - 1)
+            op_here = ops[:, j]
             holds = jnp.any((s.hand.held >= 0) & active, axis=1)
             key = 2 * op_here + (holds & carries[op_here])
 
             def chunk(carry):  # up to `size` pending rows of the least key
                 s, pending = carry
-                k = jnp.min(jnp.where(pending, key, 2 * BODY_OPS))
+                k = jnp.min(jnp.where(pending, key, 2 * len(OP)))
                 at = jnp.nonzero(pending & (key == k), size=size, fill_value=rows)[0]
                 taken = at < rows
                 sub = jax.tree.map(lambda a: a[jnp.minimum(at, rows - 1)], s)
@@ -209,7 +207,7 @@ def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCSta
     rows, size = ops.shape[0], min(ADVANCE_CHUNK, ops.shape[0])
     padding = jnp.arange(rows) >= real
     closed = (ops == OP["loop_end"]) & ~padding
-    carries = jnp.asarray([op in EMPTY_HANDED for op in range(len(OP))])
+    carries = jnp.asarray(_CARRIES)
 
     def branch(op):  # the instruction's own code only: the bookkeeping is op-generic, outside the switch
         def run(s, at, arg, pc, stepped):

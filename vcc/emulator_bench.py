@@ -141,7 +141,7 @@ def _pieces(n: int, batch: int) -> list[np.ndarray]:
 
 
 def _parts(op: int, g: dict, batch: int) -> list[np.ndarray]:
-    """A group's rows as the search splits them (`stepping.holding_split`)."""
+    """A group's rows, a carry op's holders apart (`stepping.holding_split`)."""
     rows = np.arange(len(g["rows"]))
     if op not in EMPTY_HANDED:
         return [rows]
@@ -174,9 +174,9 @@ def step_jax(p: Prepared, prepared: dict[int, list]) -> tuple[dict[int, list], d
 
 
 def _step(cfg: VCCConfig, op: int, consts, tasks, states, args):
-    """As the search steps: a closed loop's further iterations are replayed in one more
-    call (`stepping.replay_loops`, each body instruction by its own code), not in a
-    traced loop that runs every instruction's code."""
+    """One instruction's rows in one call; a closed loop's further iterations are
+    replayed in one more call (`stepping.replay_loops`, each body instruction by its own
+    code), not in a traced loop that runs every instruction's code."""
     if op != OP["loop_end"]:
         return step_examples(cfg, op, consts, tasks, states, args)
     return replay_loops(cfg, consts, tasks, step_examples(cfg, op, consts, tasks, states, args, False))

@@ -401,6 +401,7 @@ def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_pat
         (train + ["--carry", "-1"], "argument --carry: -1 is out of range"),
         (train + ["--loops", "-1"], "argument --loops: -1 is out of range"),
         (train + ["--pool", "everywhere"], "argument --pool: invalid choice"),
+        (train + ["--pool", "hidden", "--hidden", "0"], "--pool hidden pools the hidden channels"),
         (["argpred", "train", "--out", str(tmp_path), "--quiet"], "write .msgpack"),
         (["argpred", "data", "--out", str(d), "--programs", "0"], "argument --programs: 0 is out of range"),
         (["argpred", "data", "--out", str(d), "--joined", "nan"], "argument --joined: nan is not a finite number"),

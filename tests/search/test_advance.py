@@ -83,6 +83,9 @@ PROGRAMS = [
     reference_program("change_red_objs_color").text(),  # a filter, then a loop
     "scene_parse; loop_start; top_down_attend; move_hand_to_attended_object; grab_object; move_hand_to_pointer; "
     "next_object; loop_end",  # fails where a second object is grabbed while holding, or with no pointer
+    # imagination in the body (the last two instructions a body may record)
+    "scene_parse; fixate(top); loop_start; top_down_attend; imagine_object(hline); reset_imagination; "
+    "next_object; loop_end",
 ]
 
 

@@ -29,6 +29,9 @@ PROGRAMS = [
     "next_object; loop_end",
     # a body that differs in length from the others, ending in a fixation
     "scene_parse; set_color_attn(red); loop_start; top_down_attend; fixate_attended_object; next_object; loop_end",
+    # imagination in the body (the last two instructions a body may record)
+    "scene_parse; fixate(top); loop_start; top_down_attend; imagine_object(hline); reset_imagination; "
+    "next_object; loop_end",
 ]
 
 
