@@ -120,6 +120,27 @@ REPLAY_CHUNK = 4  # rows a replayed instruction runs on at a time
 _CARRIES = np.array([op in EMPTY_HANDED for op in range(len(OP))])  # ops whose cost is the carry
 
 
+def by_instruction(s: VCCState, op: jax.Array, active: jax.Array, pending: jax.Array, size: int, run) -> VCCState:
+    """Run the `pending` rows of (B, E) states `size` at a time, rows of one instruction
+    (`op`, (B,)) together, a carry op's rows that hold an object (where `active`) apart:
+    `run(rows' states, op, row indices, taken)` steps one gathered chunk (indices of
+    untaken slots repeat the last row; their results are dropped)."""
+    rows = op.shape[0]
+    holds = jnp.any((s.hand.held >= 0) & active, axis=1)
+    key = 2 * op + (holds & jnp.asarray(_CARRIES)[op])
+
+    def chunk(carry):  # up to `size` pending rows of the least key
+        s, pending = carry
+        k = jnp.min(jnp.where(pending, key, 2 * len(OP)))
+        at = jnp.nonzero(pending & (key == k), size=size, fill_value=rows)[0]
+        safe = jnp.minimum(at, rows - 1)
+        new = run(jax.tree.map(lambda a: a[safe], s), k // 2, safe, at < rows)
+        s = jax.tree.map(lambda a, b: a.at[at].set(b, mode="drop"), s, new)
+        return s, pending.at[at].set(False, mode="drop")
+
+    return jax.lax.while_loop(lambda carry: jnp.any(carry[1]), chunk, (s, pending))[0]
+
+
 @functools.partial(jax.jit, static_argnums=0)
 def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState,
                  real: jax.Array | None = None) -> VCCState:
@@ -139,7 +160,6 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
     ops, args = ctl.body_ops[:, 0], ctl.body_args[:, 0]  # (B, L): a body is the same on every example
     length, pc0 = ctl.body_len[:, 0], ctl.body_pc0[:, 0]
     rows, size = ops.shape[0], min(REPLAY_CHUNK, ops.shape[0])
-    carries = jnp.asarray(_CARRIES)
 
     def branch(op):
         def run(s, at, j, active):
@@ -160,23 +180,10 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
         live_rows = active.any(axis=1)
 
         def position(j, s):
-            op_here = ops[:, j]
-            holds = jnp.any((s.hand.held >= 0) & active, axis=1)
-            key = 2 * op_here + (holds & carries[op_here])
+            def run(sub, op, at, taken):
+                return jax.lax.switch(op, branches, sub, at, j, active[at] & taken[:, None])
 
-            def chunk(carry):  # up to `size` pending rows of the least key
-                s, pending = carry
-                k = jnp.min(jnp.where(pending, key, 2 * len(OP)))
-                at = jnp.nonzero(pending & (key == k), size=size, fill_value=rows)[0]
-                taken = at < rows
-                sub = jax.tree.map(lambda a: a[jnp.minimum(at, rows - 1)], s)
-                sub = jax.lax.switch(k // 2, branches, sub, jnp.minimum(at, rows - 1), j,
-                                     active[jnp.minimum(at, rows - 1)] & taken[:, None])
-                s = jax.tree.map(lambda a, b: a.at[at].set(b, mode="drop"), s, sub)
-                return s, pending.at[at].set(False, mode="drop")
-
-            pending = live_rows & (length > j)
-            return jax.lax.while_loop(lambda carry: jnp.any(carry[1]), chunk, (s, pending))[0]
+            return by_instruction(s, ops[:, j], active, live_rows & (length > j), size, run)
 
         steps = jnp.max(jnp.where(live_rows, length, 0))
         return it + 1, jax.lax.fori_loop(0, steps, position, s)
@@ -207,7 +214,6 @@ def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCSta
     rows, size = ops.shape[0], min(ADVANCE_CHUNK, ops.shape[0])
     padding = jnp.arange(rows) >= real
     closed = (ops == OP["loop_end"]) & ~padding
-    carries = jnp.asarray(_CARRIES)
 
     def branch(op):  # the instruction's own code only: the bookkeeping is op-generic, outside the switch
         def run(s, at, arg, pc, stepped):
@@ -245,24 +251,13 @@ def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCSta
         length, pc0 = jnp.where(is_step, 1, ctl.body_len[:, 0]), ctl.body_pc0[:, 0]
 
         def position(j, s):
-            op_here = jnp.where(is_step, ops, body_ops[:, j])
             arg_here = jnp.where(is_step, args, body_args[:, j])
-            holds = jnp.any((s.hand.held >= 0) & active, axis=1)
-            key = 2 * op_here + (holds & carries[op_here])
 
-            def chunk(carry):  # up to `size` pending rows of the least key
-                s, pending = carry
-                k = jnp.min(jnp.where(pending, key, 2 * len(OP)))
-                at = jnp.nonzero(pending & (key == k), size=size, fill_value=rows)[0]
-                taken = at < rows
-                safe = jnp.minimum(at, rows - 1)
-                sub = run_chunk(jax.tree.map(lambda a: a[safe], s), k // 2, safe, arg_here[safe], pc0[safe] + j,
-                                active[safe] & taken[:, None], is_step)
-                s = jax.tree.map(lambda a, b: a.at[at].set(b, mode="drop"), s, sub)
-                return s, pending.at[at].set(False, mode="drop")
+            def run(sub, op, at, taken):
+                return run_chunk(sub, op, at, arg_here[at], pc0[at] + j, active[at] & taken[:, None], is_step)
 
-            pending = live_rows & (length > j)
-            return jax.lax.while_loop(lambda carry: jnp.any(carry[1]), chunk, (s, pending))[0]
+            return by_instruction(s, jnp.where(is_step, ops, body_ops[:, j]), active, live_rows & (length > j),
+                                  size, run)
 
         steps = jnp.max(jnp.where(live_rows, length, 0))
         return it + 1, jax.lax.fori_loop(0, steps, position, s)
