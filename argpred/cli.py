@@ -194,9 +194,10 @@ def add_commands(sub) -> None:
                    help="share of two-part programs in newly drawn data (default: the folder's, else 0.3)")
     t.add_argument("--kernel", type=runtime.count(1, 15), default=3)
     t.add_argument("--depth", type=runtime.count(1, 8), default=1, help="hidden convolutions (with --hidden > 0)")
-    t.add_argument("--evidence", choices=("signed", "relu"), default="relu",
+    t.add_argument("--evidence", choices=("signed", "relu", "shown"), default="relu",
                    help="relu (default): an example adds evidence for an argument or nothing; signed: the "
-                        "paper's plain sum, where examples that do not show an argument count against it")
+                        "paper's plain sum, where examples that do not show an argument count against it; "
+                        "shown: an example speaks, for or against, only of a value its objects show")
     t.add_argument("--bias-start", type=runtime.number(-100, 100), default=-4.0,
                    help="first bias of every label under --evidence relu")
     t.add_argument("--carry", type=runtime.count(0, 10**6), default=30,

@@ -20,6 +20,12 @@ an example that does not show an argument then says nothing against it. Under
 of B's colour outvote the ones that show B, and B's filter is lost. The bias starts
 at `bias_start`, since the sum of ten non-negative terms would start every label
 near probability one.
+
+`evidence="shown"` lets an example speak, for or against, only of a value it shows: a
+shape or colour filter's value where its input holds an object of it, a fill's colour
+where its output does (`shown`). An "A and B" example with no object of B's colour
+says nothing of B (as under "relu"), while an example whose star stays put where a
+star filter would have moved it still counts against the filter (as under "signed").
 """
 
 from __future__ import annotations
@@ -29,13 +35,34 @@ import jax
 import jax.numpy as jnp
 
 from argpred.data import LABELS
+from vccjax.machine.instructions import COLORS, SHAPES
+
+EVIDENCE = ("signed", "relu", "shown")
+_COLOR0 = len(SHAPES)  # the first input colour channel (argpred.features)
+_DIFF0 = len(SHAPES) + len(COLORS) + 1  # the first output-minus-input channel
+
+
+def shown(x: jax.Array) -> jax.Array:
+    """(..., 21, 15, 15) features -> (..., labels) 1 where the example shows the label's
+    value: an input object of a filter's shape or colour, an output object of a fill's colour."""
+    x = x.astype(jnp.float32)
+    cols = []
+    for f, v in LABELS:
+        if f == "set_shape_attn":
+            grid = x[..., SHAPES.index(v), :, :]
+        elif f == "set_color_attn":
+            grid = x[..., _COLOR0 + COLORS.index(v), :, :]
+        else:  # fill_color: the output's colour v is input plus change
+            grid = x[..., _COLOR0 + COLORS.index(v), :, :] + x[..., _DIFF0 + _COLOR0 + COLORS.index(v), :, :]
+        cols.append((grid.max(axis=(-2, -1)) > 0).astype(jnp.float32))
+    return jnp.stack(cols, axis=-1)
 
 
 class ArgNet(nn.Module):
     hidden: int = 32
     kernel: int = 3
     depth: int = 1  # hidden convolutions (when hidden > 0)
-    evidence: str = "signed"  # "relu": an example adds evidence for a label or nothing (see below)
+    evidence: str = "signed"  # "relu" / "shown": which examples may speak of a label (see above)
     bias_start: float = -4.0  # the bias's first value under "relu" (zero under "signed")
     pool: str = "labels"  # "hidden": pool the hidden channels over positions, then a dense layer (see below)
 
@@ -58,8 +85,10 @@ class ArgNet(nn.Module):
         pooled = h.max(axis=(-3, -2))  # (B, E, labels)
         if self.evidence == "relu":
             pooled = nn.relu(pooled)
+        elif self.evidence == "shown":
+            pooled = pooled * shown(x)
         elif self.evidence != "signed":
-            raise ValueError(f"unknown evidence {self.evidence!r} (signed or relu)")
-        start = 0.0 if self.evidence == "signed" else self.bias_start
+            raise ValueError(f"unknown evidence {self.evidence!r} ({', '.join(EVIDENCE)})")
+        start = self.bias_start if self.evidence == "relu" else 0.0
         bias = self.param("bias", nn.initializers.constant(start), (len(LABELS),))
         return (pooled * mask[..., None]).sum(axis=1) + bias

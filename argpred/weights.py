@@ -24,7 +24,7 @@ from flax import serialization
 
 from argpred.data import LABELS
 from argpred.features import CHANNELS, GRID
-from argpred.model import ArgNet
+from argpred.model import EVIDENCE, ArgNet
 from vccjax import files
 from vccjax.errors import DataFileError
 
@@ -137,7 +137,7 @@ def load(path: str | Path | None = None) -> tuple[ArgNet, dict, dict]:
                        evidence=str(card["model"].get("evidence", "signed")),
                        pool=str(card["model"].get("pool", "labels")))
         members = int(card["model"].get("members", 1))
-        if model.pool not in ("labels", "hidden") or model.evidence not in ("signed", "relu"):
+        if model.pool not in ("labels", "hidden") or model.evidence not in EVIDENCE:
             raise ValueError(f"model pool {model.pool!r} / evidence {model.evidence!r} unknown")
         for name, value, low, top in (("hidden", model.hidden, 0, MAX_HIDDEN), ("kernel", model.kernel, 1, 15),
                                       ("depth", model.depth, 1, 8), ("members", members, 1, 64)):

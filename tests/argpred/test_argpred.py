@@ -236,6 +236,35 @@ def test_relu_evidence_lets_an_example_that_shows_nothing_say_nothing(tiny):
         assert (ten < seven - 1e-6).all() if lowered else np.array_equal(ten, seven)
 
 
+def test_shown_evidence_hears_an_example_only_on_values_its_objects_show():
+    import jax.numpy as jnp
+
+    from argpred.data import LABELS
+    from argpred.model import shown
+
+    # input: a red square and a green circle; output: the square turned blue
+    before = Scene((SceneObject("square", "red", 0.5, 0.5, 0.1), SceneObject("circle", "green", 0.1, 0.1, 0.1)))
+    after = Scene((SceneObject("square", "blue", 0.5, 0.5, 0.1), before.objects[1]))
+    gate = dict(zip(LABELS, np.asarray(shown(jnp.asarray(pair_features([(before, after)])))[0])))
+    want = {("set_shape_attn", "square"), ("set_shape_attn", "circle"), ("set_color_attn", "red"),
+            ("set_color_attn", "green"), ("fill_color", "blue"), ("fill_color", "green")}  # red left the output
+    assert {k for k, v in gate.items() if v == 1} == want and set(gate.values()) == {0.0, 1.0}
+    # a network whose every example says "no": the examples that show no such value are not heard
+    m = ArgNet(hidden=4, evidence="shown")
+    p = init_params(m, 0)
+    p["conv_hidden"]["bias"] = jnp.ones_like(p["conv_hidden"]["bias"])
+    p["conv_out"]["kernel"] = -jnp.abs(p["conv_out"]["kernel"])
+    one = jnp.asarray(pair_features([(before, after)]))[None]
+    two = jnp.asarray(pair_features([(before, after), (before, after)]))[None]
+    l1 = np.asarray(m.apply({"params": p}, one, jnp.ones((1, 1))))[0]
+    l2 = np.asarray(m.apply({"params": p}, two, jnp.ones((1, 2))))[0]
+    heard = np.array([k in want for k in LABELS])
+    assert (l2[heard] < l1[heard] - 1e-6).all()  # a second example showing the value counts against it
+    assert np.array_equal(l2[~heard], l1[~heard]) and np.array_equal(l1[~heard], np.asarray(p["bias"])[~heard])
+    with pytest.raises(ValueError, match="unknown evidence"):
+        ArgNet(hidden=4, evidence="maybe").apply({"params": p}, one, jnp.ones((1, 1)))
+
+
 def test_an_ensemble_averages_its_members_and_round_trips(tiny, tmp_path):
     from argpred.train import train_members
     from argpred.weights import members_of
