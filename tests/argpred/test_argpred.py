@@ -12,8 +12,7 @@ from argpred import data as argdata
 from argpred.features import CHANNEL_NAMES, CHANNELS, GRID, pair_features
 from argpred.predict import THRESHOLD, Predictor, argument_logp
 from argpred.train import TrainSettings, train
-from argpred.model import ArgNet
-from argpred.weights import init_params, load, save
+from argpred.weights import load, save
 from vccjax.errors import DataFileError
 from vccjax.machine.program import check_loop_syntax, parse
 from vccjax.machine.scene import Scene, SceneObject
@@ -59,18 +58,6 @@ def test_drawn_programs_pass_the_filters_and_are_labelled():
 
     out = RefMachine(both).run(loop).output_scene()
     assert not argdata.indispensable(loop, [(both, out)])
-
-
-@pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("argdata")
-    arrays = argdata.build_shard(seed=5, shard=0, size=24)
-    np.savez_compressed(folder / "shard0000.npz", **arrays)
-    manifest = {"format": argdata.FORMAT, "version": argdata.VERSION, "seed": 5, "shard": 24,
-                "labels": [list(x) for x in argdata.LABELS], "max_objects": 8,
-                "shards": {"shard0000.npz": argdata._sha(folder / "shard0000.npz")}}
-    (folder / "manifest.json").write_text(json.dumps(manifest))
-    return folder
 
 
 def test_shards_are_seeded_and_data_loads_verified(tiny):
@@ -179,119 +166,6 @@ def test_carry_programs_are_seeded_two_attend_procedures_in_their_own_folder(tmp
         argdata.build(tmp_path / "other", 5, seed=2, progress=False, kind="carry", joined=0.3)
     with pytest.raises(ValueError, match="unknown kind"):
         argdata.build(tmp_path / "other", 5, kind="enumerated")
-
-
-def test_pooling_the_hidden_channels_weighs_the_whole_grid_and_round_trips(tiny, tmp_path):
-    """pool="hidden": each example's logits are a dense layer of its hidden channels'
-    maxima over the grid (so a unit firing anywhere can lower a label), as computed here
-    by hand; the card says so and the weights load back as that model."""
-    import jax
-    import jax.numpy as jnp
-
-    from argpred.features import features_from_cells
-
-    d = argdata.load(tiny)
-    model, params, _ = train(d, TrainSettings(hidden=4, epochs=1, batch=8, pool="hidden"), progress=False)
-    x = jnp.asarray(features_from_cells(d["inputs"][:3], d["outputs"][:3]))
-    h = jnp.moveaxis(x.astype(jnp.float32), -3, -1)
-    conv = params["conv_hidden"]
-    h = jax.nn.relu(jax.lax.conv_general_dilated(h.reshape(-1, *h.shape[2:]), conv["kernel"], (1, 1), "SAME",
-                                                 dimension_numbers=("NHWC", "HWIO", "NHWC")) + conv["bias"])
-    per_example = jax.nn.relu(h.max(axis=(1, 2)) @ params["dense_out"]["kernel"]).reshape(3, 10, -1)
-    by_hand = per_example.sum(axis=1) + params["bias"]
-    np.testing.assert_allclose(np.asarray(model.apply({"params": params}, x, jnp.ones((3, 10)))),
-                               np.asarray(by_hand), rtol=1e-5, atol=1e-5)
-    save(tmp_path / "p.msgpack", model, params)
-    m2, _, card = load(tmp_path / "p.msgpack")
-    assert card["model"]["pool"] == "hidden" and m2.pool == "hidden"
-    card["model"]["pool"] = "everywhere"
-    (tmp_path / "p.json").write_text(json.dumps(card))
-    with pytest.raises(DataFileError, match="pool 'everywhere'"):
-        load(tmp_path / "p.msgpack")
-
-
-def test_relu_evidence_lets_an_example_that_shows_nothing_say_nothing(tiny):
-    import jax.numpy as jnp
-
-    d = argdata.load(tiny)
-    from argpred.features import features_from_cells
-
-    x = jnp.asarray(features_from_cells(d["inputs"][:4], d["outputs"][:4]))  # (4, 10, 21, 15, 15)
-    mask7 = jnp.ones((4, 10)).at[:, 7:].set(0)
-    model, params, _ = train(d, TrainSettings(hidden=4, epochs=2, batch=8), progress=False)  # relu: the default
-    seven = model.apply({"params": params}, x, mask7)
-    ten = model.apply({"params": params}, x, jnp.ones((4, 10)))
-    assert (np.asarray(ten) >= np.asarray(seven) - 1e-6).all()  # more examples can only add evidence
-    # every position's logit below zero (positive hidden units, negative output kernel): under
-    # the paper's signed sum the three examples added lower every label; under relu they say nothing
-    import jax
-
-    for evidence, lowered in (("signed", True), ("relu", False)):
-        m = ArgNet(hidden=4, evidence=evidence)
-        p = jax.tree.map(lambda w: w, init_params(m, 0))
-        p["conv_hidden"]["bias"] = jnp.ones_like(p["conv_hidden"]["bias"])  # every hidden unit > 0 everywhere
-        p["conv_out"]["kernel"] = -jnp.abs(p["conv_out"]["kernel"])
-        seven = np.asarray(m.apply({"params": p}, x, mask7))
-        ten = np.asarray(m.apply({"params": p}, x, jnp.ones((4, 10))))
-        assert (ten < seven - 1e-6).all() if lowered else np.array_equal(ten, seven)
-
-
-def test_shown_evidence_hears_an_example_only_on_values_its_objects_show():
-    import jax.numpy as jnp
-
-    from argpred.data import LABELS
-    from argpred.model import shown
-
-    # input: a red square and a green circle; output: the square turned blue
-    before = Scene((SceneObject("square", "red", 0.5, 0.5, 0.1), SceneObject("circle", "green", 0.1, 0.1, 0.1)))
-    after = Scene((SceneObject("square", "blue", 0.5, 0.5, 0.1), before.objects[1]))
-    gate = dict(zip(LABELS, np.asarray(shown(jnp.asarray(pair_features([(before, after)])))[0])))
-    want = {("set_shape_attn", "square"), ("set_shape_attn", "circle"), ("set_color_attn", "red"),
-            ("set_color_attn", "green"), ("fill_color", "blue"), ("fill_color", "green")}  # red left the output
-    assert {k for k, v in gate.items() if v == 1} == want and set(gate.values()) == {0.0, 1.0}
-    # a network whose every example says "no": the examples that show no such value are not heard
-    m = ArgNet(hidden=4, evidence="shown")
-    p = init_params(m, 0)
-    p["conv_hidden"]["bias"] = jnp.ones_like(p["conv_hidden"]["bias"])
-    p["conv_out"]["kernel"] = -jnp.abs(p["conv_out"]["kernel"])
-    one = jnp.asarray(pair_features([(before, after)]))[None]
-    two = jnp.asarray(pair_features([(before, after), (before, after)]))[None]
-    l1 = np.asarray(m.apply({"params": p}, one, jnp.ones((1, 1))))[0]
-    l2 = np.asarray(m.apply({"params": p}, two, jnp.ones((1, 2))))[0]
-    heard = np.array([k in want for k in LABELS])
-    assert (l2[heard] < l1[heard] - 1e-6).all()  # a second example showing the value counts against it
-    assert np.array_equal(l2[~heard], l1[~heard]) and np.array_equal(l1[~heard], np.asarray(p["bias"])[~heard])
-    with pytest.raises(ValueError, match="unknown evidence"):
-        ArgNet(hidden=4, evidence="maybe").apply({"params": p}, one, jnp.ones((1, 1)))
-
-
-def test_an_ensemble_averages_its_members_and_round_trips(tiny, tmp_path):
-    from argpred.train import train_members
-    from argpred.weights import members_of
-
-    d = argdata.load(tiny)
-    settings = TrainSettings(hidden=4, epochs=2, batch=8)
-    model, stacked, histories = train_members(d, settings, 2, checkpoint=tmp_path / "e.ckpt", progress=False)
-    assert members_of(stacked) == 2 and len(histories) == 2
-    assert (tmp_path / "e.m0.ckpt").exists() and (tmp_path / "e.m1.ckpt").exists()  # each resumable
-    save(tmp_path / "e.msgpack", model, stacked)
-    _, _, card = load(tmp_path / "e.msgpack")
-    assert card["model"]["members"] == 2
-    import jax
-
-    from argpred.features import features_from_cells
-
-    x = features_from_cells(d["inputs"][:3], d["outputs"][:3])
-    singles = []
-    for k in range(2):
-        save(tmp_path / f"m{k}.msgpack", model, jax.tree.map(lambda w, k=k: w[k], stacked))
-        singles.append(Predictor(tmp_path / f"m{k}.msgpack").probabilities(x))
-    np.testing.assert_allclose(Predictor(tmp_path / "e.msgpack").probabilities(x), np.mean(singles, axis=0),
-                               rtol=1e-5, atol=1e-6)
-    # member k is the single network trained from seed + k
-    _, alone, _ = train(d, TrainSettings(hidden=4, epochs=2, batch=8, seed=1), progress=False)
-    for a, b in zip(jax.tree.leaves(alone), jax.tree.leaves(jax.tree.map(lambda w: w[1], stacked))):
-        np.testing.assert_allclose(np.asarray(a), np.asarray(b), rtol=1e-5, atol=1e-6)
 
 
 def test_predicted_arguments_keep_only_those_that_pass():
