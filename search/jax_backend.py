@@ -1,17 +1,17 @@
 """The search's backend on the JAX emulator: many concepts' children stepped together,
-one device call per atom position of a round.
+one device call per piece of a round's rows.
 
 The concepts being searched have their example scenes and targets in a bank of
 `width` slots on the device (a fixed shape: each instruction compiles once whatever the
 number of concepts); a batch's rows are programs, each reading its concept's slot.
 On the host a prefix's states are one packed int32 row per example (`search.packing`),
-so a frame is one array and a transfer one copy. A request's children are stepped
-atom by atom (a subroutine is several): all of an atom's rows, whatever their
-instruction, and the further iterations of the loops they close run in one device call
-per piece of rows (`stepping.advance`: rows of one instruction taken a few at a time
-through one switch), so a round makes one call where it made one per instruction, and
-one function compiles where one per instruction (and again for the replay) did.
-Complete programs are judged on the device.
+so a frame is one array and a transfer one copy. A round's children, whatever their
+instructions, are stepped by all their atoms (a subroutine is several, in turn) with
+the further iterations of the loops they close in one device call per piece of rows
+(`stepping.advance_atoms`: rows of one instruction taken a few at a time through one
+switch), so a round makes one call where it made one per atom position (and before
+that one per instruction), and one function compiles. Complete programs are judged on
+the device.
 
 This module is the only part of the search that reads the machine state's fields
 (the section "the machine state's fields" below).
@@ -29,12 +29,15 @@ import numpy as np
 from search.backend import Reply, Request
 from search.device_calls import BUCKETS, DeviceCalls
 from search.packing import blackboard_columns, pack_state, unpack_blackboard, unpack_state
-from search.stepping import advance
+from search.stepping import advance_atoms
 from search.task import Task
 
 # One batch size for the step (with its replay): its cost follows the rows it runs, not
-# the padding (only copied), so one compile serves every round.
+# the padding (only copied), so one compile serves every round. A call steps up to
+# ATOM_COLUMNS atoms of each row (a longer portion takes another call): a fixed shape too,
+# and columns no row reaches cost nothing.
 STEP_ROWS = (256,)
+ATOM_COLUMNS = 8
 from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
 from vccjax.machine.match import ASK, YES, Target, verdict
 from vccjax.machine.scene import scenes_match
@@ -66,9 +69,9 @@ def _device_verdicts(cfg: VCCConfig, consts: SceneConst, targets: Target, slots,
 
 @functools.partial(jax.jit, static_argnums=0)
 def _advance_packed(cfg: VCCConfig, consts: SceneConst, slots, packed, ops, args, real):
-    """`stepping.advance` on packed states, the first `real` rows; return the states and
-    whether each program failed on any example."""
-    new = advance(cfg, consts, slots, unpack_state(packed, cfg), ops, args, real)
+    """`stepping.advance_atoms` on packed states, the first `real` rows; return the states
+    and whether each program failed on any example."""
+    new = advance_atoms(cfg, consts, slots, unpack_state(packed, cfg), ops, args, real)
     return pack_state(new, cfg), _failed_anywhere(new)
 
 
@@ -81,6 +84,14 @@ def _packed_root(cfg: VCCConfig) -> np.ndarray:
 def _put_in_slot(bank, slot, item):
     """`item` into slot `slot` of every leaf of `bank` (one compiled update, not one per leaf)."""
     return jax.tree.map(lambda b, a: b.at[slot].set(a), bank, item)
+
+
+def _columns(m: np.ndarray, fill: int) -> np.ndarray:
+    """The first ATOM_COLUMNS columns of (n, k) `m`, padded with `fill`."""
+    out = np.full((len(m), ATOM_COLUMNS), fill, m.dtype)
+    width = min(ATOM_COLUMNS, m.shape[1])
+    out[:, :width] = m[:, :width]
+    return out
 
 
 def _atoms(requests: Sequence[Request]) -> tuple[np.ndarray, np.ndarray]:
@@ -137,10 +148,10 @@ class JaxBackend:
         slots = np.array([self._slot_of[id(r.task)] for r in requests], np.int32)[owner]
         ops, args = _atoms(requests)
         failed = np.zeros(len(owner), bool)
-        for k in range(ops.shape[1]):  # every child's k-th atom (portions are -1 padded)
+        for k in range(0, ops.shape[1], ATOM_COLUMNS):  # every child's atoms k.. (portions are -1 padded)
             source, source_row = (parents, parent_row) if k == 0 else (children, np.arange(len(owner)))
-            self._step_atoms(ops[:, k], np.ascontiguousarray(args[:, k]), slots, source, source_row, children,
-                             failed)
+            self._step_atoms(_columns(ops[:, k:], -1), _columns(args[:, k:], 0), slots, source, source_row,
+                             children, failed)
         may_end = np.concatenate([r.may_end for r in requests])
         solved = self._judge(requests, owner, slots, children, np.nonzero(may_end & ~failed)[0], failed)
         return [Reply(children[a:b], failed[a:b], solved[a:b]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
@@ -175,11 +186,11 @@ class JaxBackend:
 
     def _step_atoms(self, ops: np.ndarray, args: np.ndarray, slots: np.ndarray, source: np.ndarray,
                     source_row: np.ndarray, children: np.ndarray, failed: np.ndarray) -> None:
-        """Step each child not yet failed by its atom `ops[i]` (none where -1), from state
-        `source[source_row[i]]` into `children[i]`, a closed loop's further iterations
-        included; mark `failed` (both in place). One device call per piece of `STEP_ROWS`
-        rows (`stepping.advance`)."""
-        rows = np.nonzero((ops >= 0) & ~failed)[0]
+        """Step each child not yet failed by its atoms `ops[i]` (ATOM_COLUMNS of them, -1
+        where none) in turn, from state `source[source_row[i]]` into `children[i]`, closed
+        loops' further iterations included; mark `failed` (both in place). One device call
+        per piece of `STEP_ROWS` rows (`stepping.advance_atoms`)."""
+        rows = np.nonzero((ops[:, 0] >= 0) & ~failed)[0]
         if len(rows) == 0:
             return
         cfg, (consts, _) = self.cfg, self._bank

@@ -202,7 +202,30 @@ def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCSta
     every further iteration of the loops that step closed, all in one device call with
     one switch over the instructions (so each instruction's code is compiled once, not
     once for the step and once for the replay). Rows from `real` on are padding: left as
-    they came.
+    they came."""
+    return _advance(cfg, consts, tasks, states, ops, args, jnp.arange(ops.shape[0]) < real)
+
+
+@functools.partial(jax.jit, static_argnums=0)
+def advance_atoms(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState, ops: jax.Array,
+                  args: jax.Array, real: jax.Array) -> VCCState:
+    """`advance` by each row's atoms in turn (`ops`, `args`: (B, K), -1 where a row's
+    portion has no more atoms): a subroutine's atoms in one device call instead of one
+    call each. A row failed on some example stops there (the search drops it). Columns
+    past the last atom any row has cost nothing (the loop runs to that atom only)."""
+    rows = jnp.arange(ops.shape[0]) < real
+    last = jnp.max(jnp.where(rows[:, None] & (ops >= 0), jnp.arange(ops.shape[1]) + 1, 0))
+
+    def atom(k, s):
+        run = rows & (ops[:, k] >= 0) & ~jnp.any(s.control.failed, axis=1)
+        return _advance(cfg, consts, tasks, s, jnp.where(run, ops[:, k], 0), args[:, k], run)
+
+    return jax.lax.fori_loop(0, last, atom, states)
+
+
+def _advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState, ops: jax.Array,
+             args: jax.Array, live: jax.Array) -> VCCState:
+    """`advance` of the rows where `live` (B,); the others are left as they came.
 
     The step is iteration 0 of the replay's loop: at each position (one for the step,
     the body's for a replay) the rows that run there are taken `ADVANCE_CHUNK` at a time,
@@ -211,8 +234,8 @@ def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCSta
     (`before_op`, `after_op`; a `loop_end` only closes the loop), in a replay on the
     examples still looping (as `replay_examples`). A program that failed on some
     example is dead: its loop is not replayed further."""
-    rows, size = ops.shape[0], min(ADVANCE_CHUNK, ops.shape[0])
-    padding = jnp.arange(rows) >= real
+    size = min(ADVANCE_CHUNK, ops.shape[0])
+    padding = ~live
     closed = (ops == OP["loop_end"]) & ~padding
 
     def branch(op):  # the instruction's own code only: the bookkeeping is op-generic, outside the switch

@@ -111,3 +111,44 @@ def test_programs_stepped_atom_by_atom_end_where_the_whole_run_ends(text):
     np.testing.assert_array_equal(stepped.control.failed, whole.control.failed)
     for got, want in zip(jax.tree.leaves(stepped), jax.tree.leaves(whole), strict=True):
         np.testing.assert_array_equal(got[ran], want[ran])  # a failed row stops where it failed
+
+
+def test_rows_of_different_programs_stepped_by_all_their_atoms_in_one_call_end_where_each_run_ends():
+    """`advance_atoms`: each row its own program (its atoms -1 padded), in one call or cut
+    into two calls of columns, ends where the machine's run of that program ends."""
+    from search.stepping import advance_atoms
+
+    rng = np.random.default_rng(11)
+    programs = [parse(t) for t in PROGRAMS] + [parse("scene_parse; top_down_attend; fill_color(blue)")]
+    rows = [(p, random_scene(rng, n, pointer=bool(k % 2))) for p in programs for k, n in enumerate((2, 5, 7))]
+    consts = stack([load_scene(s) for _, s in rows])
+    bank = jax.tree.map(lambda a: a[:, None], consts)  # a task per row
+    tasks = jnp.arange(len(rows), dtype=jnp.int32)
+    width = max(len(p.ops) for p in programs)
+    ops = np.full((len(rows) + 2, width), -1, np.int32)  # two padding rows past `real`
+    args = np.zeros_like(ops)
+    for i, (p, _) in enumerate(rows):
+        ops[i, : len(p.ops)], args[i, : len(p.args)] = p.ops, p.args
+    tasks = jnp.concatenate([tasks, jnp.zeros(2, jnp.int32)])
+    start = jax.tree.map(lambda a: a[:, None], jax.vmap(lambda _: init_state(CFG))(tasks))
+    real = jnp.int32(len(rows))
+    once = advance_atoms(CFG, bank, tasks, start, jnp.asarray(ops), jnp.asarray(args), real)
+    cut = 3
+    twice = advance_atoms(CFG, bank, tasks, start, jnp.asarray(ops[:, :cut]), jnp.asarray(args[:, :cut]), real)
+    twice = advance_atoms(CFG, bank, tasks, twice, jnp.asarray(ops[:, cut:]), jnp.asarray(args[:, cut:]), real)
+    once, twice, start = jax.device_get((once, twice, start))
+    fails = set()
+    for i, (p, _) in enumerate(rows):
+        o, a, _ = p.arrays(pad_length(len(p.ops)))
+        whole = jax.device_get(run_batch(CFG, jax.tree.map(lambda x, i=i: x[i : i + 1], consts),
+                                         jnp.asarray(o), jnp.asarray(a)))
+        failed = bool(whole.control.failed[0])
+        fails.add(failed)
+        for got in (once, twice):
+            assert bool(got.control.failed[i, 0]) == failed, p.text()
+            if not failed:
+                for g, w in zip(jax.tree.leaves(got), jax.tree.leaves(whole), strict=True):
+                    np.testing.assert_array_equal(g[i, 0], w[0], err_msg=p.text())
+    assert fails == {True, False}
+    for g, w in zip(jax.tree.leaves(once), jax.tree.leaves(start), strict=True):
+        np.testing.assert_array_equal(g[len(rows):], w[len(rows):])  # padding left as it came
