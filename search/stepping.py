@@ -3,7 +3,8 @@ example scenes, stepped together on the device.
 
 A search holds (B, E) states, B programs times E examples. `advance` steps each row by
 its own instruction and replays the loops closed, in one device call through one
-switch over the instructions (what the search runs). `step_examples` steps all rows by
+switch over the instructions; `advance_atoms` does so for each of a row's atoms in turn
+(a subroutine is several), a search round in one call. `step_examples` steps all rows by
 one static op; with replay=False a `loop_end` only closes the loop and `replay_loops`
 runs every further iteration in one call, each body instruction by its own code only
 (`replay_examples`): the emulator benchmark's per-instruction calls.
