@@ -55,6 +55,11 @@ class Backend(Protocol):
         """Rows `rows` of a reply's states, copied so that they outlive the next request."""
         ...
 
+    def join(self, parts: Sequence[object]) -> object:
+        """States of several frames as one (rows in order), for a request that runs
+        children of several frames together."""
+        ...
+
     def admit(self, task: Task, alongside: Sequence[Task]) -> None:
         """Get ready to run `task`'s programs while `alongside` (tasks already admitted and
         still searched) keep running theirs."""

@@ -3,8 +3,9 @@
 Depth-first over chunks of the frontier (memory stays bounded by depth x chunk): a
 frame holds up to `chunk` live prefixes with their states on all examples; its
 children (prefix + one portion) are made cheapest first and handed to the backend in
-slices. A child that fails on any example is dropped with its whole subtree (docs/vcc.md
-section 3); so is one whose cheapest completion costs more than the cutoff. A child
+slices, a slice filled from the frames below the top when the top has few left
+(`_fill`). A child that fails on any example is dropped with its whole subtree
+(docs/vcc.md section 3); so is one whose cheapest completion costs more than the cutoff. A child
 that may end is a complete program: the backend judges it against every example's
 output. The search runs to the end of the tree (paper: DFS to completion) but, once a
 program is found, only cheaper ones can replace it, so the cutoff drops to just below
@@ -186,35 +187,37 @@ def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chun
     nodes = len(prefix)  # the prefix's steps
     end_bins = chain.trans_bins[:, chain.end]  # the cost of ending after each token
     while frames:
-        frame = frames[-1]
-        if frame.children is None:
-            frame.children = _children(chain, frame, limits.cutoff)
-        picked = _next_slice(frame, limits.cutoff, slice_size)
-        if picked is None:
-            frames.pop()
-            continue
-        parents, portions, cost = (a[picked] for a in frame.children[:3])
-        tokens = chain.tok[portions]
-        syntax = chain.next_syn[tokens, frame.syntax[parents]]
-        cost_ended = cost + end_bins[tokens]
-        may_end = (syntax == OUTSIDE) & (cost_ended <= limits.cutoff)
-        reply = yield Request(chain, task, frame.states, parents, portions, may_end)
-        nodes += len(picked)
-        paths = frame.path[parents].copy()
-        if frame.depth < MAX_PORTIONS:
-            paths[:, frame.depth] = portions
-        for i in np.nonzero(~reply.failed & may_end)[0]:
-            if limits.counts_program(int(cost_ended[i])) and reply.solved[i]:
-                limits.found(int(cost_ended[i]), paths[i])
-        if progress:
-            progress(len(picked))
-        live = ~reply.failed & (cost + chain.min_rest[tokens, np.maximum(syntax, 0)] <= limits.cutoff) & (syntax >= 0)
-        if frame.depth + 1 < MAX_PORTIONS:
-            rows = np.nonzero(live)[0]
-            for part in np.array_split(rows, max(1, -(-len(rows) // chunk))):  # chunks of at most `chunk`
-                if len(part):
-                    frames.append(_Frame(backend.take(reply.states, part), tokens[part], syntax[part], cost[part],
-                                         paths[part], frame.depth + 1))
+        slices = _fill(chain, frames, limits.cutoff, slice_size)
+        if not slices:
+            break
+        parts = [_Part(chain, frame, picked, limits.cutoff, end_bins) for frame, picked in slices]
+        if len(parts) == 1:
+            states, parents = parts[0].frame.states, parts[0].parents
+        else:  # the parents the slices use, of every frame, as one array
+            used = [np.unique(p.parents, return_inverse=True) for p in parts]
+            states = backend.join([backend.take(p.frame.states, u) for p, (u, _) in zip(parts, used)])
+            offsets = np.cumsum([0] + [len(u) for u, _ in used[:-1]])
+            parents = np.concatenate([inv.reshape(-1) + o for (_, inv), o in zip(used, offsets)])
+        reply = yield Request(chain, task, states, parents, np.concatenate([p.portions for p in parts]),
+                              np.concatenate([p.may_end for p in parts]))
+        start = 0
+        for p in parts:  # each slice's children, as its frame's alone
+            rows = np.arange(start, start + len(p.portions))
+            start += len(p.portions)
+            nodes += len(rows)
+            for i in np.nonzero(~reply.failed[rows] & p.may_end)[0]:
+                if limits.counts_program(int(p.cost_ended[i])) and reply.solved[rows[i]]:
+                    limits.found(int(p.cost_ended[i]), p.paths[i])
+            if progress:
+                progress(len(rows))
+            live = (~reply.failed[rows] & (p.cost + chain.min_rest[p.tokens, np.maximum(p.syntax, 0)] <= limits.cutoff)
+                    & (p.syntax >= 0))
+            if p.frame.depth + 1 < MAX_PORTIONS:
+                keep = np.nonzero(live)[0]
+                for part in np.array_split(keep, max(1, -(-len(keep) // chunk))):  # chunks of at most `chunk`
+                    if len(part):
+                        frames.append(_Frame(backend.take(reply.states, rows[part]), p.tokens[part],
+                                             p.syntax[part], p.cost[part], p.paths[part], p.frame.depth + 1))
     best = limits.best[:2] if limits.best else None
     return Outcome(best, nodes, limits.programs, limits.b_star, limits.counts, limits.kept())
 
@@ -230,6 +233,43 @@ def _children(chain: Chain, frame: _Frame, cutoff: int) -> _Children:
     order = np.argsort(cost[parent, portion], kind="stable")
     parent, portion = parent[order], portion[order]
     return _Children(parent, portion, cost[parent, portion], bound[parent, portion])
+
+
+class _Part:
+    """One frame's slice of children in a request: what they add, cost and complete."""
+
+    def __init__(self, chain: Chain, frame: _Frame, picked: np.ndarray, cutoff: int, end_bins: np.ndarray):
+        self.frame = frame
+        self.parents, self.portions, self.cost = (a[picked] for a in frame.children[:3])
+        self.tokens = chain.tok[self.portions]
+        self.syntax = chain.next_syn[self.tokens, frame.syntax[self.parents]]
+        self.cost_ended = self.cost + end_bins[self.tokens]
+        self.may_end = (self.syntax == OUTSIDE) & (self.cost_ended <= cutoff)
+        self.paths = frame.path[self.parents].copy()
+        if frame.depth < MAX_PORTIONS:
+            self.paths[:, frame.depth] = self.portions
+
+
+def _fill(chain: Chain, frames: list[_Frame], cutoff: int, size: int) -> list[tuple[_Frame, np.ndarray]]:
+    """Slices of up to `size` children in all: the top frame's next ones, then, while
+    there is room, the next frames' down the stack (a deep frame often has only a few
+    children under the cutoff, and a round of a few rows costs nearly as much as a full
+    one). Frames with nothing left are dropped. Every frame is run to its end whatever
+    the order, so the search covers the same programs; only which of equally cheap
+    programs is met first can differ from a one-frame-at-a-time order."""
+    out, room, k = [], size, len(frames) - 1
+    while k >= 0 and room > 0:
+        frame = frames[k]
+        if frame.children is None:
+            frame.children = _children(chain, frame, cutoff)
+        picked = _next_slice(frame, cutoff, room)
+        if picked is None:
+            del frames[k]
+        else:
+            out.append((frame, picked))
+            room -= len(picked)
+        k -= 1
+    return out
 
 
 def _next_slice(frame: _Frame, cutoff: int, size: int) -> np.ndarray | None:

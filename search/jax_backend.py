@@ -132,6 +132,9 @@ class JaxBackend:
     def take(self, states: np.ndarray, rows: np.ndarray) -> np.ndarray:
         return states[rows]
 
+    def join(self, parts: Sequence[np.ndarray]) -> np.ndarray:
+        return np.concatenate(parts)
+
     def admit(self, task: Task, alongside: Sequence[Task]) -> None:
         """`task` takes the first bank slot that none of `alongside` holds."""
         used = {self._slot_of.get(id(t)) for t in alongside}

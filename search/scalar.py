@@ -37,6 +37,9 @@ class ScalarBackend:
     def take(self, states: Machines, rows: np.ndarray) -> Machines:
         return [states[i] for i in rows]
 
+    def join(self, parts: Sequence[Machines]) -> Machines:
+        return [m for part in parts for m in part]
+
     def admit(self, task: Task, alongside: Sequence[Task]) -> None:
         pass
 
