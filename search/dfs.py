@@ -205,8 +205,11 @@ def depth_first(chain: Chain, task: Task, budget: int, backend: Backend, *, chun
             rows = np.arange(start, start + len(p.portions))
             start += len(p.portions)
             nodes += len(rows)
+            # a program counts only under the cutoff as it is now (a find earlier in this
+            # request may have lowered it), so counting does not depend on how slices are made
             for i in np.nonzero(~reply.failed[rows] & p.may_end)[0]:
-                if limits.counts_program(int(p.cost_ended[i])) and reply.solved[rows[i]]:
+                if (p.cost_ended[i] <= limits.cutoff and limits.counts_program(int(p.cost_ended[i]))
+                        and reply.solved[rows[i]]):
                     limits.found(int(p.cost_ended[i]), p.paths[i])
             if progress:
                 progress(len(rows))
@@ -256,7 +259,8 @@ def _fill(chain: Chain, frames: list[_Frame], cutoff: int, size: int) -> list[tu
     children under the cutoff, and a round of a few rows costs nearly as much as a full
     one). Frames with nothing left are dropped. Every frame is run to its end whatever
     the order, so the search covers the same programs; only which of equally cheap
-    programs is met first can differ from a one-frame-at-a-time order."""
+    programs is met first (ties at b* included), and how many children a round runs
+    past a find, can differ from a one-frame-at-a-time order."""
     out, room, k = [], size, len(frames) - 1
     while k >= 0 and room > 0:
         frame = frames[k]

@@ -9,8 +9,9 @@ so a frame is one array and a transfer one copy. A round's children, whatever th
 instructions, are stepped by all their atoms (a subroutine is several, in turn) with
 the further iterations of the loops they close in one device call per piece of rows
 (`stepping.advance_atoms`: rows of one instruction taken a few at a time through one
-switch), so a round makes one call where it made one per atom position (and before
-that one per instruction), and one function compiles. Complete programs are judged on
+switch; a portion longer than `ATOM_COLUMNS` atoms takes a call per further group), so
+a round makes one call where it made one per atom position (and before that one per
+instruction), and one function compiles. Complete programs are judged on
 the device.
 
 This module is the only part of the search that reads the machine state's fields
@@ -141,13 +142,14 @@ class JaxBackend:
         self._load(next(k for k in range(self.width) if k not in used), task)
 
     def apply_many(self, requests: Sequence[Request]) -> list[Reply]:
-        """Every request's children stepped together, atom by atom (each atom's rows in one
-        call whatever their instructions); then the children that may end judged together."""
+        """Every request's children stepped together by all their atoms (up to ATOM_COLUMNS
+        atoms per call, whatever their instructions); then the children that may end
+        judged together."""
         sizes = [len(r.portions) for r in requests]
         bounds = np.cumsum([0] + sizes)
         owner = np.repeat(np.arange(len(requests)), sizes)  # (n,) the request of each child
         parents, parent_row = self._parents(requests)
-        children = self._children_room((len(owner),) + parents.shape[1:], parents.dtype)  # filled atom by atom
+        children = self._children_room((len(owner),) + parents.shape[1:], parents.dtype)  # filled by the calls
         slots = np.array([self._slot_of[id(r.task)] for r in requests], np.int32)[owner]
         ops, args = _atoms(requests)
         failed = np.zeros(len(owner), bool)

@@ -1,6 +1,7 @@
 """Rounds filled from several frames (`search.dfs._fill`): the search still covers every
 program under the cutoff once, counts the budget exactly and finds the cheapest program,
-whatever the frame and slice sizes."""
+whatever the frame and slice sizes; and a subroutine longer than one call's atom columns
+is stepped in several calls as in one."""
 
 from __future__ import annotations
 
@@ -84,3 +85,18 @@ def test_the_cheapest_program_is_found_whatever_the_frame_and_slice_sizes(ds):
     small = Explorer(chunk=4, slice_size=16).search(chain, task, 20_000)
     large = ScalarExplorer().search(chain, task, 20_000)
     assert small.found and (small.rank, small.dl_bins) == (large.rank, large.dl_bins)
+
+
+def test_subroutines_longer_than_a_calls_atom_columns_search_as_the_scalar_search(ds, monkeypatch):
+    import search.jax_backend as jb
+    from search.induce import Settings, argument_logp
+    from search.library import load
+
+    lib = load(None)  # the shipped library: subroutines of several atoms
+    chain = Chain(lib.vocab, lib.model, argument_logp(Settings(args="oracle"), SHORT))
+    assert chain.op_mat.shape[1] > 2
+    monkeypatch.setattr(jb, "ATOM_COLUMNS", 2)  # a portion of 3 or more atoms takes two calls or more
+    task = Task.from_pairs(ds.pairs(SHORT, "train"))
+    a = Explorer().search(chain, task, 5000)
+    b = ScalarExplorer().search(chain, task, 5000)
+    assert a.found and (a.text, a.rank, a.nodes, a.programs) == (b.text, b.rank, b.nodes, b.programs)
