@@ -33,7 +33,7 @@ class TrainSettings:
     hidden: int = 32
     kernel: int = 3
     depth: int = 1
-    evidence: str = "relu"  # or "signed", the paper's plain sum (argpred.model)
+    evidence: str = "relu"  # or "signed" (the paper's plain sum) or "shown" (argpred.model)
     bias_start: float = -4.0
     pool: str = "labels"  # or "hidden" (argpred.model)
     epochs: int = 30
