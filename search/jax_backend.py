@@ -32,6 +32,10 @@ from search.device_calls import BUCKETS, DeviceCalls
 from search.packing import blackboard_columns, pack_state, unpack_blackboard, unpack_state
 from search.stepping import advance_atoms
 from search.task import Task
+from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
+from vccjax.machine.match import ASK, YES, Target, verdict
+from vccjax.machine.scene import scenes_match
+from vccjax.machine.state import SceneConst, VCCState, init_state, output_scene
 
 # One batch size for the step (with its replay): its cost follows the rows it runs, not
 # the padding (only copied), so one compile serves every round. A call steps up to
@@ -39,10 +43,6 @@ from search.task import Task
 # and columns no row reaches cost nothing.
 STEP_ROWS = (256,)
 ATOM_COLUMNS = 8
-from vccjax.machine.config import DEFAULT_CONFIG, VCCConfig
-from vccjax.machine.match import ASK, YES, Target, verdict
-from vccjax.machine.scene import scenes_match
-from vccjax.machine.state import SceneConst, VCCState, init_state, output_scene
 
 
 # ---- the machine state's fields: the only places the search reads them ----------------

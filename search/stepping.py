@@ -1,10 +1,9 @@
 """The search's batched stepping: many programs of many concepts, each on its concept's
 example scenes, stepped together on the device.
 
-A search holds (B, E) states, B programs times E examples. `advance` steps each row by
-its own instruction and replays the loops closed, in one device call through one
-switch over the instructions; `advance_atoms` does so for each of a row's atoms in turn
-(a subroutine is several), a search round in one call. `step_examples` steps all rows by
+A search holds (B, E) states, B programs times E examples. `advance_atoms` steps each
+row by its own atoms in turn (a subroutine is several) and replays the loops each step
+closes, a search round in one device call through one switch over the instructions. `step_examples` steps all rows by
 one static op; with replay=False a `loop_end` only closes the loop and `replay_loops`
 runs every further iteration in one call, each body instruction by its own code only
 (`replay_examples`): the emulator benchmark's per-instruction calls.
@@ -45,7 +44,7 @@ def holding_split(op: int, rows: np.ndarray, holding: np.ndarray,
     """`rows` split into those where some example holds an object (`holding`, one bool per
     row) and the rest, for a carry op (the rest then skip the carry: `EMPTY_HANDED`),
     when that makes the carrying calls smaller: padded to the same sizes, the split
-    would only add a call (the emulator benchmark's per-instruction calls; `advance`
+    would only add a call (the emulator benchmark's per-instruction calls; `advance_atoms`
     groups a carry op's holders apart on the device)."""
     if op not in EMPTY_HANDED or sum(piece_sizes(int(holding.sum()))) >= sum(piece_sizes(len(rows))):
         return [rows]
@@ -193,27 +192,20 @@ def replay_loops(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: V
                               (jnp.int32(1), states))[1]
 
 
-ADVANCE_CHUNK = 4  # rows of one instruction `advance` runs at a time
-
-
-@functools.partial(jax.jit, static_argnums=0)
-def advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState, ops: jax.Array,
-            args: jax.Array, real: jax.Array) -> VCCState:
-    """Step row b of (B, E) states by its own instruction (`ops[b]`, `args[b]`), then run
-    every further iteration of the loops that step closed, all in one device call with
-    one switch over the instructions (so each instruction's code is compiled once, not
-    once for the step and once for the replay). Rows from `real` on are padding: left as
-    they came."""
-    return _advance(cfg, consts, tasks, states, ops, args, jnp.arange(ops.shape[0]) < real)
+ADVANCE_CHUNK = 4  # rows of one instruction `advance_atoms` runs at a time
 
 
 @functools.partial(jax.jit, static_argnums=0)
 def advance_atoms(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState, ops: jax.Array,
                   args: jax.Array, real: jax.Array) -> VCCState:
-    """`advance` by each row's atoms in turn (`ops`, `args`: (B, K), -1 where a row's
-    portion has no more atoms): a subroutine's atoms in one device call instead of one
-    call each. A row failed on some example stops there (the search drops it). Columns
-    past the last atom any row has cost nothing (the loop runs to that atom only)."""
+    """Step row b of (B, E) states by its own atoms in turn (`ops[b]`, `args[b]`: K of
+    them, -1 where the row's portion has no more; a subroutine is several), each step
+    followed by every further iteration of the loops it closed, all in one device call
+    with one switch over the instructions (so each instruction's code is compiled once,
+    not once for the step and once for the replay). A row failed on some example stops
+    there (the search drops it). Rows from `real` on are padding: left as they came.
+    Columns past the last atom any row has cost nothing (the loop runs to that atom
+    only); a single step is the one-column case."""
     rows = jnp.arange(ops.shape[0]) < real
     last = jnp.max(jnp.where(rows[:, None] & (ops >= 0), jnp.arange(ops.shape[1]) + 1, 0))
 
@@ -226,7 +218,8 @@ def advance_atoms(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: 
 
 def _advance(cfg: VCCConfig, consts: SceneConst, tasks: jax.Array, states: VCCState, ops: jax.Array,
              args: jax.Array, live: jax.Array) -> VCCState:
-    """`advance` of the rows where `live` (B,); the others are left as they came.
+    """One atom of `advance_atoms` for the rows where `live` (B,); the others are left as
+    they came.
 
     The step is iteration 0 of the replay's loop: at each position (one for the step,
     the body's for a replay) the rows that run there are taken `ADVANCE_CHUNK` at a time,

@@ -1,8 +1,9 @@
-"""The search's step (`search.stepping.advance`): each row stepped by its own
-instruction and the loops it closes replayed, all in one call through one switch, ends
-exactly where the machine's own step of that instruction ends (`step_examples` with its
+"""The search's step (`search.stepping.advance_atoms`; one column: each row stepped by
+its own instruction and the loops it closes replayed, all in one call through one
+switch, ends exactly where the machine's own step of that instruction ends (`step_examples` with its
 loop replay); padding rows are left as they came; and programs stepped atom by atom
-through it end where the machine's run of the whole program ends."""
+through it, or by all their atoms in one call, end where the machine's run of the whole
+program ends)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from search.stepping import advance, step_examples
+from search.stepping import advance_atoms, step_examples
 from vccjax.machine.config import DEFAULT_CONFIG as CFG
 from vccjax.machine.instructions import OP
 from vccjax.machine.program import parse
@@ -59,7 +60,7 @@ def test_rows_of_different_instructions_step_as_the_machine_steps_each():
     ops = jnp.asarray([OP[o] for o, *_ in rows] + [OP["grab_object"]] * padding, jnp.int32)
     args = jnp.asarray([a for _, a, _ in rows] + [0] * padding, jnp.int32)
     tasks = jnp.zeros(len(ops), jnp.int32)
-    out = advance(CFG, bank, tasks, batch, ops, args, jnp.int32(len(rows)))
+    out = advance_atoms(CFG, bank, tasks, batch, ops[:, None], args[:, None], jnp.int32(len(rows)))
     one = jnp.zeros(1, jnp.int32)
     outcomes = set()
     for k, (name, arg, start) in enumerate(rows):
@@ -101,8 +102,8 @@ def test_programs_stepped_atom_by_atom_end_where_the_whole_run_ends(text):
     states = jax.tree.map(lambda a: a[:, None], jax.vmap(lambda _: init_state(CFG))(tasks))
     real = jnp.int32(len(scenes))
     for op, arg in zip(program.ops, program.args, strict=True):
-        states = advance(CFG, bank, tasks, states, jnp.full(tasks.shape, op, jnp.int32),
-                         jnp.full(tasks.shape, arg, jnp.int32), real)
+        states = advance_atoms(CFG, bank, tasks, states, jnp.full((len(tasks), 1), op, jnp.int32),
+                               jnp.full((len(tasks), 1), arg, jnp.int32), real)
     ops, args, _ = program.arrays(pad_length(len(program.ops)))
     whole = run_batch(CFG, consts, jnp.asarray(ops), jnp.asarray(args))
     ran = ~np.asarray(whole.control.failed)
@@ -116,8 +117,6 @@ def test_programs_stepped_atom_by_atom_end_where_the_whole_run_ends(text):
 def test_rows_of_different_programs_stepped_by_all_their_atoms_in_one_call_end_where_each_run_ends():
     """`advance_atoms`: each row its own program (its atoms -1 padded), in one call or cut
     into two calls of columns, ends where the machine's run of that program ends."""
-    from search.stepping import advance_atoms
-
     rng = np.random.default_rng(11)
     programs = [parse(t) for t in PROGRAMS] + [parse("scene_parse; top_down_attend; fill_color(blue)")]
     rows = [(p, random_scene(rng, n, pointer=bool(k % 2))) for p in programs for k, n in enumerate((2, 5, 7))]
