@@ -197,23 +197,34 @@ def cmd_bench_reproduce(a: argparse.Namespace) -> int:
         return 0
     if a.scale <= 0:
         raise ValueError(f"--scale must be positive, got {a.scale}")
+    if a.workers is not None and a.cluster != "ray":
+        raise ValueError("--workers: only with --cluster ray")
     names = concept_list(a.concepts)
     tag = rp.concept_tag(a.concepts, names)
     runs = Path(a.runs)
+    searcher = None
     if rows:
         enable_compile_cache()
+        if a.cluster == "ray":  # each iteration's concepts in chunks of --width to Ray workers
+            from search.cluster import ClusterSearcher
+
+            searcher = ClusterSearcher(workers=a.workers, width=a.width)
     interrupted = False
-    for k, row in enumerate(rows):
-        out = rp.folder(runs, row, tag, a.scale)
-        print(f"[{k + 1}/{len(rows)}] {row.name}: {row.what} -> {out}", flush=True)
-        try:
-            s = rp.run_row(row, names, out, a.scale, a.dataset, a.width, not a.quiet)
-        except KeyboardInterrupt:
-            interrupted = True
-            print(f"interrupted: {out} resumes where it stopped when this command is run again")
-            break
-        print(f"  induced {s['found']} of {s['concepts']}, {s['exact_on_all_test_pairs']} exact on all test pairs, "
-              f"{s['wall_seconds']:.0f} s")
+    try:
+        for k, row in enumerate(rows):
+            out = rp.folder(runs, row, tag, a.scale)
+            print(f"[{k + 1}/{len(rows)}] {row.name}: {row.what} -> {out}", flush=True)
+            try:
+                s = rp.run_row(row, names, out, a.scale, a.dataset, a.width, not a.quiet, searcher)
+            except KeyboardInterrupt:
+                interrupted = True
+                print(f"interrupted: {out} resumes where it stopped when this command is run again")
+                break
+            print(f"  induced {s['found']} of {s['concepts']}, {s['exact_on_all_test_pairs']} exact on all test "
+                  f"pairs, {s['wall_seconds']:.0f} s")
+    finally:
+        if searcher is not None:
+            searcher.close()
     _write_report(a, runs)
     return 130 if interrupted else 0
 
@@ -312,6 +323,11 @@ def add_commands(sub) -> None:
     r.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
     r.add_argument("--width", type=runtime.count(1, 4096), default=32,
                    help="concepts searched in lockstep (default 32)")
+    r.add_argument("--cluster", choices=["none", "ray"], default="none",
+                   help="'ray': search each iteration's concepts on Ray workers, --width concepts a chunk, "
+                        "each worker on a core of its own (docs/cluster.md); the same results")
+    r.add_argument("--workers", type=runtime.count(1, 4096),
+                   help="Ray workers, one CPU each (default: one per CPU of the cluster)")
     r.add_argument("--quiet", action="store_true", help="no progress bars")
     _report_flags(r)
     r.set_defaults(fn=cmd_bench_reproduce)

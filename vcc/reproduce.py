@@ -96,7 +96,10 @@ def folder(runs: Path, row: Row, tag: str, scale: float) -> Path:
 
 
 def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset: str | None, width: int,
-            progress: bool) -> dict:
+            progress: bool, searcher=None) -> dict:
+    """One row's run, resumed where it stopped; `searcher` (default: one `Explorer` of
+    `width`) may be a `search.cluster.ClusterSearcher`: the same results, each concept's
+    search does not depend on where it runs."""
     from search.explore import Explorer
     from search.induce import induce, summary
     from vccjax.world.dataset import dataset_for
@@ -108,7 +111,7 @@ def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset:
         got = ds.pairs(c, split)
         return got[: row.examples] if split == "train" else got
 
-    run = induce(names, pairs, out, scaled(row, scale), explorer=Explorer(width=width), progress=progress,
+    run = induce(names, pairs, out, scaled(row, scale), explorer=searcher or Explorer(width=width), progress=progress,
                  examples_sha256=lambda c: f"{ds.sha256(c)}:first{row.examples}")
     s = {**summary(run, names), "complete": True, "concepts_list": names}
     files.write_json(out / "summary.json", s)

@@ -105,6 +105,27 @@ def test_vcc_induce_on_a_local_cluster_writes_one_row_per_concept(tmp_path):
     assert sorted(c for c, _, _ in _rows(out)) == sorted(names.split(","))
 
 
+def test_vcc_bench_reproduce_on_a_local_cluster_gives_the_single_process_rows(tmp_path):
+    """A paper's row on workers (`vcc bench reproduce --cluster ray`): the rows one process
+    writes, concept for concept."""
+    import subprocess
+    import sys
+
+    def reproduce(where, *more):
+        done = subprocess.run([sys.executable, "-m", "vcc", "bench", "reproduce", "--rows", "examples-2",
+                               "--concepts", "remove_top_obj,remove_bottom_obj", "--scale", "0.004", "--width", "1",
+                               "--quiet", "--runs", str(where / "runs"), "--out", str(where / "r.json"),
+                               "--report", str(where / "REPORT.md"), "--others", "", "--robot", "", *more],
+                              capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stderr[-2000:]
+        (row,) = (where / "runs").iterdir()
+        return sorted(_rows(row))
+
+    single = reproduce(tmp_path / "one")
+    assert [c for c, _, _ in single] == ["remove_bottom_obj", "remove_top_obj"]
+    assert reproduce(tmp_path / "ray", "--cluster", "ray", "--workers", "1") == single
+
+
 def test_a_chunk_that_keeps_killing_its_worker_ends_the_run_with_its_name():
     """A lost host is retried; a chunk whose worker dies every time is a bug: after
     MAX_TRIES reruns the pool stops with a line naming the chunk, the other chunks done."""

@@ -619,6 +619,10 @@ case("bench-reproduce-rows-unknown", "bench", "reproduce", *_flags(REP, rows="o3
 case("bench-reproduce-rows-commas", "bench", "reproduce", *_flags(REP, rows=",,,"), writes=W_REP)
 case("bench-reproduce-list-bad-rows", "bench", "reproduce", *_flags(REP, rows="bogus", list=True), writes=W_REP)
 case("bench-reproduce-dup-rows", "bench", "reproduce", *_flags(REP, **NONE), "--rows", "none", writes=W_REP)
+case("bench-reproduce-workers-without-cluster", "bench", "reproduce", *_flags(REP, **NONE, workers="2"), writes=W_REP)
+case("bench-reproduce-workers-zero", "bench", "reproduce", *_flags(REP, **NONE, cluster="ray", workers="0"),
+     writes=W_REP)
+case("bench-reproduce-cluster-unknown", "bench", "reproduce", *_flags(REP, **NONE, cluster="spark"), writes=W_REP)
 ROW = {"rows": "examples-1", "concepts": "remove_top_obj", "scale": "0.000001", "quiet": True}
 case("bench-reproduce-width-zero", "bench", "reproduce", *_flags(REP, **ROW, width="0"), writes=W_REP, slow=True)
 case("bench-reproduce-dataset-flipped", "bench", "reproduce", *_flags(REP, **ROW, dataset="{tmp}/ds/flipped"),
