@@ -17,9 +17,14 @@ import json
 from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from search.induce import Settings
 from vccjax import files
+
+if TYPE_CHECKING:
+    from search.cluster import ClusterSearcher
+    from search.explore import Searcher
 
 MAIN = "o1-predfix-0.5M"  # the issue's headline run: order 1, predicted + fixation, 0.5M
 
@@ -96,7 +101,7 @@ def folder(runs: Path, row: Row, tag: str, scale: float) -> Path:
 
 
 def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset: str | None, width: int,
-            progress: bool, searcher=None) -> dict:
+            progress: bool, searcher: Searcher | ClusterSearcher | None = None) -> dict:
     """One row's run, resumed where it stopped; `searcher` (default: one `Explorer` of
     `width`) may be a `search.cluster.ClusterSearcher`: the same results, each concept's
     search does not depend on where it runs."""
@@ -111,8 +116,8 @@ def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset:
         got = ds.pairs(c, split)
         return got[: row.examples] if split == "train" else got
 
-    run = induce(names, pairs, out, scaled(row, scale), explorer=searcher or Explorer(width=width), progress=progress,
-                 examples_sha256=lambda c: f"{ds.sha256(c)}:first{row.examples}")
+    run = induce(names, pairs, out, scaled(row, scale), explorer=searcher or Explorer(width=width),
+                 progress=progress, examples_sha256=lambda c: f"{ds.sha256(c)}:first{row.examples}")
     s = {**summary(run, names), "complete": True, "concepts_list": names}
     files.write_json(out / "summary.json", s)
     return s
