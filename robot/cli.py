@@ -126,14 +126,8 @@ def cmd_suite(a: argparse.Namespace) -> int:
     if a.scenarios < 1 or a.count < 1:
         raise ValueError("--scenarios and --count must be positive")
     shard = _shard(a.shard)
-    if a.workers is not None and a.cluster != "ray":
-        raise ValueError("--workers: only with --cluster ray")
-    if a.cluster == "ray":
-        if shard != (0, 1):
-            raise ValueError("--shard splits a suite between processes by hand; --cluster ray does it itself")
-        from vccjax.actor_pool import ray_module
-
-        ray_module()  # a missing extra fails now, with its message
+    if runtime.on_cluster(a) and shard != (0, 1):
+        raise ValueError("--shard splits a suite between processes by hand; --cluster ray does it itself")
     programs, names = _suite_programs(a)  # bad input ends here, before JAX and MuJoCo start
     print(f"{len(names)} concepts from {programs.source.kind} {programs.source.path or ''}, "
           f"{a.scenarios} scenarios each" + (f", shard {a.shard}" if a.shard != "0/1" else ""))
@@ -250,11 +244,7 @@ def add_commands(sub) -> None:
     u.add_argument("--status", action="store_true",
                    help="only summarise what the folder holds (writes summary.json), running no rollout")
     u.add_argument("--all-cores", action="store_true", help="let XLA use every core")
-    u.add_argument("--cluster", choices=["none", "ray"], default="none",
-                   help="'ray': roll the batches out on Ray workers, one core each; this process writes the "
-                        "records (joins $RAY_ADDRESS, or starts a local cluster; docs/cluster.md)")
-    u.add_argument("--workers", type=runtime.count(1, 4096),
-                   help="Ray workers (default: one per CPU of the cluster)")
+    runtime.cluster_flags(u, "roll the batches out on Ray workers, one core each; this process writes the records")
     u.set_defaults(fn=cmd_suite)
 
     c = s.add_parser("perception", help="the arm camera's parse against the true tables, nominal and harder",

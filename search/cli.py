@@ -13,12 +13,7 @@ def cmd_induce(a: argparse.Namespace) -> int:
     from search.induce import Settings, induce, needs_answer, summary
     from vccjax.world.dataset import dataset_for
 
-    if a.workers is not None and a.cluster != "ray":
-        raise ValueError("--workers: only with --cluster ray")
-    if a.cluster == "ray":
-        from search.cluster import ray_module
-
-        ray_module()  # a missing extra fails now, with its message
+    runtime.on_cluster(a)
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations, parts=a.parts,
                         arg_threshold=a.arg_threshold)
@@ -147,10 +142,6 @@ def add_commands(sub) -> None:
                         "builds these concepts' examples under ~/.cache/vccjax")
     p.add_argument("--width", type=runtime.count(1, 4096), default=32,
                    help="concepts searched in lockstep, their programs stepped in shared batches (default 32)")
-    p.add_argument("--cluster", choices=["none", "ray"], default="none",
-                   help="'ray': search each iteration's concepts on Ray workers, --width concepts a chunk "
-                        "(joins $RAY_ADDRESS, or starts a local cluster; docs/cluster.md)")
-    p.add_argument("--workers", type=runtime.count(1, 4096),
-                   help="Ray workers, one CPU each (default: one per CPU of the cluster)")
+    runtime.cluster_flags(p, "search each iteration's concepts on Ray workers, --width concepts a chunk")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(fn=cmd_induce)

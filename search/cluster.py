@@ -23,9 +23,9 @@ from search.chain import Chain
 from search.dfs import Alternatives
 from search.result import Result
 from search.task import Task
-from vccjax.actor_pool import ActorPool, ray_module
+from vccjax.actor_pool import ActorPool
 
-__all__ = ["ClusterSearcher", "ray_module"]
+__all__ = ["ClusterSearcher"]
 
 
 class _Worker:

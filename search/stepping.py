@@ -3,10 +3,11 @@ example scenes, stepped together on the device.
 
 A search holds (B, E) states, B programs times E examples. `advance_atoms` steps each
 row by its own atoms in turn (a subroutine is several) and replays the loops each step
-closes, a search round in one device call through one switch over the instructions. `step_examples` steps all rows by
-one static op; with replay=False a `loop_end` only closes the loop and `replay_loops`
-runs every further iteration in one call, each body instruction by its own code only
-(`replay_examples`): the emulator benchmark's per-instruction calls.
+closes, a search round in one device call through one switch over the instructions.
+`step_examples` steps all rows by one static op; with replay=False a `loop_end` only
+closes the loop and `replay_loops` runs every further iteration in one call, each body
+instruction by its own code only (`replay_examples`): the emulator benchmark's
+per-instruction calls.
 """
 
 from __future__ import annotations

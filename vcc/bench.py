@@ -197,15 +197,14 @@ def cmd_bench_reproduce(a: argparse.Namespace) -> int:
         return 0
     if a.scale <= 0:
         raise ValueError(f"--scale must be positive, got {a.scale}")
-    if a.workers is not None and a.cluster != "ray":
-        raise ValueError("--workers: only with --cluster ray")
+    cluster = runtime.on_cluster(a)
     names = concept_list(a.concepts)
     tag = rp.concept_tag(a.concepts, names)
     runs = Path(a.runs)
     searcher = None
     if rows:
         enable_compile_cache()
-        if a.cluster == "ray":  # each iteration's concepts in chunks of --width to Ray workers
+        if cluster:  # each iteration's concepts in chunks of --width to Ray workers
             from search.cluster import ClusterSearcher
 
             searcher = ClusterSearcher(workers=a.workers, width=a.width)
@@ -323,11 +322,8 @@ def add_commands(sub) -> None:
     r.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax)")
     r.add_argument("--width", type=runtime.count(1, 4096), default=32,
                    help="concepts searched in lockstep (default 32)")
-    r.add_argument("--cluster", choices=["none", "ray"], default="none",
-                   help="'ray': search each iteration's concepts on Ray workers, --width concepts a chunk, "
-                        "each worker on a core of its own (docs/cluster.md); the same results")
-    r.add_argument("--workers", type=runtime.count(1, 4096),
-                   help="Ray workers, one CPU each (default: one per CPU of the cluster)")
+    runtime.cluster_flags(r, "search each iteration's concepts on Ray workers, --width concepts a chunk; "
+                             "the same results")
     r.add_argument("--quiet", action="store_true", help="no progress bars")
     _report_flags(r)
     r.set_defaults(fn=cmd_bench_reproduce)

@@ -74,6 +74,27 @@ def error_line(e: BaseException) -> str:
     return str(e) or type(e).__name__
 
 
+def cluster_flags(parser: argparse.ArgumentParser, what: str) -> None:
+    """`--cluster` and `--workers`, spelt alike by every command that can hand its work
+    to Ray workers; `what` says what `--cluster ray` does there."""
+    parser.add_argument("--cluster", choices=["none", "ray"], default="none",
+                        help=f"'ray': {what} (joins $RAY_ADDRESS, or starts a local cluster; docs/cluster.md)")
+    parser.add_argument("--workers", type=count(1, 4096),
+                        help="Ray workers, one core each (default: one per CPU of the cluster)")
+
+
+def on_cluster(a: argparse.Namespace) -> bool:
+    """Whether the command runs on Ray (`cluster_flags`): `--workers` without `--cluster
+    ray` is refused, and a missing Ray extra fails now, before any work, with its message."""
+    if a.workers is not None and a.cluster != "ray":
+        raise ValueError("--workers: only with --cluster ray")
+    if a.cluster == "ray":
+        from vccjax.actor_pool import ray_module
+
+        ray_module()
+    return a.cluster == "ray"
+
+
 def count(low: int = 1, high: int | None = None) -> Callable[[str], int]:
     """An argparse type: a whole number from `low` to `high`, checked when the command
     line is read (before any work)."""

@@ -1,9 +1,9 @@
-"""The search's step (`search.stepping.advance_atoms`; one column: each row stepped by
-its own instruction and the loops it closes replayed, all in one call through one
-switch, ends exactly where the machine's own step of that instruction ends (`step_examples` with its
-loop replay); padding rows are left as they came; and programs stepped atom by atom
-through it, or by all their atoms in one call, end where the machine's run of the whole
-program ends)."""
+"""The search's step (`search.stepping.advance_atoms`): with one column, each row stepped
+by its own instruction and the loops it closes replayed, all in one call through one
+switch, ends exactly where the machine's own step of that instruction ends
+(`step_examples` with its loop replay); padding rows are left as they came; and
+programs stepped atom by atom through it, or by all their atoms in one call, end where
+the machine's run of the whole program ends."""
 
 from __future__ import annotations
 
