@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from argpred.data import PREDICTED
+from argpred.gained import with_fill
 from argpred.predict import THRESHOLD, Predictor, passing
 from vccjax.world.concepts import reference_program
 from vccjax.machine.instructions import NAMES, arg_domain
@@ -27,27 +28,39 @@ def used_arguments(concept: str) -> dict[str, set[str]]:
 
 
 def recall(predictor: Predictor, concepts: Sequence[str],
-           pairs: Callable[[str], list[tuple[Scene, Scene]]], threshold: float = THRESHOLD) -> dict:
+           pairs: Callable[[str], list[tuple[Scene, Scene]]], threshold: float = THRESHOLD,
+           fill: str = "predicted") -> dict:
+    """Recall and extra arguments; `fill` 'gained' takes fill_color's from the pairs
+    (`argpred.gained`), as the search does by default."""
     missed: dict[str, dict[str, list[str]]] = {}
     extra = {f: [] for f in PREDICTED}
+    extras: dict[str, dict[str, list[str]]] = {}  # per concept, the arguments passed that it never uses
+    unused, kept = dict.fromkeys(PREDICTED, 0), dict.fromkeys(PREDICTED, 0)
     for c in concepts:
-        ok = passing(predictor.for_pairs(pairs(c)), threshold)
+        ok = passing(with_fill(predictor.for_pairs(pairs(c)), pairs(c), fill), threshold)
         used = used_arguments(c)
         miss = {f: sorted(used[f] - set(ok[f])) for f in PREDICTED if used[f] - set(ok[f])}
         if miss:
             missed[c] = miss
         for f in PREDICTED:
-            extra[f].append(len(set(ok[f]) - used[f]))
+            more = sorted(set(ok[f]) - used[f])
+            extra[f].append(len(more))
+            if more:
+                extras.setdefault(c, {})[f] = more
+            if not used[f]:  # a function the concept never uses stays in its search if any argument passes
+                unused[f] += 1
+                kept[f] += bool(ok[f])
     return {
-        "concepts": len(concepts), "threshold": threshold, "recalled": len(concepts) - len(missed),
+        "concepts": len(concepts), "threshold": threshold, "fill": fill, "recalled": len(concepts) - len(missed),
         "recall": (len(concepts) - len(missed)) / len(concepts),
         "mean_extra_arguments": {f: float(np.mean(v)) for f, v in extra.items()},
-        "missed": missed,
+        "unused_function_kept": {f: {"kept": kept[f], "of_concepts_not_using_it": unused[f]} for f in PREDICTED},
+        "missed": missed, "extra_arguments": extras,
     }
 
 
 def measure(weights=None, concepts: Sequence[str] | None = None, dataset=None,
-            threshold: float = THRESHOLD) -> tuple[dict, dict]:
+            threshold: float = THRESHOLD, fill: str = "predicted") -> tuple[dict, dict]:
     """(`recall` of the weights at `weights` (default: the shipped ones) on `concepts`
     (default: all 546) with the training pairs of `dataset` (default: the shipped
     examples) at `threshold`, the weights' card)."""
@@ -59,7 +72,7 @@ def measure(weights=None, concepts: Sequence[str] | None = None, dataset=None,
         raise ValueError("no concepts to measure recall on")
     predictor = Predictor(weights)
     ds = dataset_for(names, 0, dataset, progress=False)
-    return recall(predictor, names, lambda c: ds.pairs(c, "train"), threshold), predictor.card
+    return recall(predictor, names, lambda c: ds.pairs(c, "train"), threshold, fill), predictor.card
 
 
 def card_record(r: dict, date: str, command: str) -> dict:

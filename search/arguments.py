@@ -3,9 +3,11 @@ from its example pairs, an answer program, or a teacher's hint.
 
 Modes (`vcc induce --args`, `vcc learn`):
 - uniform: every value of every instruction's domain, equally likely;
-- predicted: `set_shape_attn`, `set_color_attn` and `fill_color` from the argument CNN
-  on the training pairs (arguments under 0.55 dropped, an instruction with none left out;
-  `argpred.predict`); `fixate` and `imagine_object` uniform;
+- predicted: `set_shape_attn` and `set_color_attn` from the argument CNN on the training
+  pairs (arguments under 0.55 dropped, an instruction with none left out;
+  `argpred.predict`); `fill_color` the colours some object gains in the pairs
+  (`argpred.gained`; `fill="predicted"`: from the CNN as the filters); `fixate` and
+  `imagine_object` uniform;
 - oracle: uniform over the values an answer program uses, an instruction with arguments
   it never uses left out (what a perfect predictor gives; a research setting that reads
   the answer, never a default);
@@ -44,10 +46,11 @@ def used_values(program: Program, name: str) -> list[int]:
 
 def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None, answer: Program | None = None,
                   fixate: Sequence[str] | None = None, fallback: bool = False,
-                  threshold: float | None = None) -> dict[int, np.ndarray]:
+                  threshold: float | None = None, fill: str = "gained") -> dict[int, np.ndarray]:
     """log p(argument | instruction) under `mode` (see the module's docstring). `answer`
     is needed by oracle and, without `fixate`, by +fixation; `pairs` by predicted, which
-    keeps the arguments at or above `threshold` (default the paper's 0.55)."""
+    keeps the arguments at or above `threshold` (default the paper's 0.55) and takes
+    `fill_color`'s as `fill` says ('gained' or 'predicted')."""
     if mode not in MODES:
         raise ValueError(f"--args must be one of {', '.join(MODES)}, got {mode!r}")
     out = uniform_args()
@@ -60,7 +63,9 @@ def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
 
         if not pairs:
             raise ValueError("--args predicted needs the concept's training pairs")
-        probs = default_predictor().for_pairs(pairs)
+        from argpred.gained import with_fill
+
+        probs = with_fill(default_predictor().for_pairs(pairs), pairs, fill)
         for name, lp in predicted(probs, THRESHOLD if threshold is None else threshold).items():
             if fallback and not np.isfinite(lp).any():
                 p = np.asarray(probs[name], np.float64)

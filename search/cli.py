@@ -16,7 +16,7 @@ def cmd_induce(a: argparse.Namespace) -> int:
     runtime.on_cluster(a)
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations, parts=a.parts,
-                        arg_threshold=a.arg_threshold)
+                        arg_threshold=a.arg_threshold, fill=a.fill)
     if a.dataset:  # any built dataset: the concepts its manifest holds, their stored programs as answers
         from vccjax.world.dataset import Dataset
 
@@ -130,6 +130,10 @@ def add_commands(sub) -> None:
     p.add_argument("--arg-threshold", type=runtime.number(0, 1, above=True), default=0.55,
                    help="with --args predicted: an argument passes at this predicted probability (default 0.55, "
                         "the paper's); a function none of whose arguments pass is left out")
+    p.add_argument("--fill", choices=["gained", "predicted"], default="gained",
+                   help="with --args predicted: fill_color's arguments are the colours some object gains in the "
+                        "pairs (default; exact: only fill_color changes a colour), or 'predicted' by the network "
+                        "as the filters (the paper's)")
     p.add_argument("--parts", type=runtime.count(1, 3), default=1,
                    help="2 or 3: after the iterations, a last pass over the concepts still missed, each "
                         "searched whole with the model of everything found and, where that fails, in up to "

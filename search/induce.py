@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from argpred.gained import FILL_MODES
 from search.arguments import MODES as ARG_MODES
 from search.chain import Chain
 from search.explore import Explorer, Searcher
@@ -54,6 +55,7 @@ class Settings:
     delta: float = 0.01  # nats per cost bin
     parts: int = 1  # >= 2: a last pass over missed concepts, whole then in up to this many parts (1: none)
     arg_threshold: float = 0.55  # predicted arguments pass at this probability (the paper's 0.55)
+    fill: str = "gained"  # predicted modes: fill_color's arguments from the colours objects gain, or "predicted"
 
     def __post_init__(self) -> None:
         if self.args not in ARG_MODES:
@@ -66,6 +68,8 @@ class Settings:
             raise ValueError(f"--parts must be 1, 2 or 3, got {self.parts}")
         if not 0 < self.arg_threshold <= 1:
             raise ValueError(f"--arg-threshold must be above 0 and at most 1, got {self.arg_threshold}")
+        if self.fill not in FILL_MODES:
+            raise ValueError(f"--fill must be one of {', '.join(FILL_MODES)}, got {self.fill!r}")
 
 
 def needs_answer(settings: Settings) -> bool:
@@ -82,7 +86,7 @@ def argument_logp(settings: Settings, concept: str, pairs: Sequence[tuple[Scene,
 
     if answer is None and needs_answer(settings):
         answer = reference_program(concept)
-    return logp(settings.args, pairs, answer, threshold=settings.arg_threshold)
+    return logp(settings.args, pairs, answer, threshold=settings.arg_threshold, fill=settings.fill)
 
 
 def fit_model(programs: Sequence[Program], settings: Settings, with_subroutines: bool):
@@ -220,10 +224,15 @@ def same_search(recorded: object, mine: dict) -> bool:
     """Whether a run folder's recorded settings search as `mine`: all alike but `parts`,
     which only adds a pass after the iterations (a folder written before it existed
     holds none), so a finished run may be resumed to add it. A folder written before
-    `arg_threshold` existed searched at 0.55."""
+    `arg_threshold` existed searched at 0.55, one written before `fill` took fill_color's
+    arguments from the network; `fill` matters only to predicted arguments."""
     if not isinstance(recorded, dict):
         return False
-    return {"arg_threshold": 0.55, **recorded, "parts": 0} == {**mine, "parts": 0}
+    a = {"arg_threshold": 0.55, "fill": "predicted", **recorded, "parts": 0}
+    b = {**mine, "parts": 0}
+    if not str(b.get("args", "")).startswith("predicted"):
+        a.pop("fill"), b.pop("fill", None)
+    return a == b
 
 
 def read_records(path: Path) -> list[dict]:

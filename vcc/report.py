@@ -91,6 +91,17 @@ def _pass(settings: dict) -> str:
             if settings.get("parts", 1) > 1 else "")
 
 
+def _predicted(settings: dict) -> str:
+    """With predicted arguments: a threshold other than the paper's 0.55, and fill_color's
+    arguments from the colours objects gain (`--fill gained`; folders written before
+    `fill` existed took them from the network)."""
+    if not str(settings.get("args", "")).startswith("predicted"):
+        return ""
+    t = settings.get("arg_threshold", 0.55)
+    return ((f", threshold {t:g}" if t != 0.55 else "")
+            + (", fill_color from the colours objects gain" if settings.get("fill") == "gained" else ""))
+
+
 def _weights(s: dict | None) -> str:
     """Which argument-predictor weights a run used, where its run.json says."""
     return f" (predictor `{s['predictor_sha256'][:8]}`)" if s and s.get("predictor_sha256") else ""
@@ -108,7 +119,8 @@ def reproduce_section(rows: dict[str, dict]) -> list[str]:
             continue
         for key, s in _row_runs(rows, row.name) or [(row.name, None)]:
             lines.append(
-                f"| {row.name} | {row.what}{_weights(s)} | {row.paper} | {_cell(s)} | "
+                f"| {row.name} | {row.what}{_predicted(st := (s or {}).get('settings', {}))}{_pass(st)}{_weights(s)} | "
+                f"{row.paper} | {_cell(s)} | "
                 + (f"{s['found_without_subroutines']} | {s['exact_on_all_test_pairs']} | "
                    f"{s['wall_seconds'] / 60:.0f} min | `{key}` |" if s else "- | - | - | - |"))
     curve = [(row, _row_runs(rows, row.name)) for row in rp.ROWS if row.short_only]
@@ -185,7 +197,8 @@ def other_runs_section(folder: Path) -> list[str]:
         if s is None:
             continue
         lines.append(f"| `{path}` | order {st.get('order')}, {st.get('args')} arguments, budget {st.get('budget'):,}, "
-                     f"subroutines {'on' if st.get('subroutines') else 'off'}{_pass(st)}{_weights(s)} | {_cell(s)} | "
+                     f"subroutines {'on' if st.get('subroutines') else 'off'}{_predicted(st)}{_pass(st)}{_weights(s)} | "
+                     f"{_cell(s)} | "
                      f"{s['found_without_subroutines']} | {s['exact_on_all_test_pairs']} | "
                      f"{s['wall_seconds'] / 60:.0f} min | {s['programs_per_second']:,} "
                      f"({s['programs_run_per_second']:,}) |")
@@ -307,8 +320,8 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
     if not runs:
         return []
     lines = ["## Argument predictor: recall and extra arguments (`vcc argpred eval`)", "",
-             "| file | weights | concepts (split) | threshold | recalled: every used argument passes | "
-             "mean extra arguments per concept, by function | not recalled |", "|---|---|---|---|---|---|---|"]
+             "| file | weights | fill_color from | concepts (split) | threshold | recalled: every used argument passes | "
+             "mean extra arguments per concept, by function | not recalled |", "|---|---|---|---|---|---|---|---|"]
     for name, d in runs:
         n = d["concepts"] if isinstance(d["concepts"], int) else len(d["concepts"])
         extra = ", ".join(f"{f} {v:.2f}" for f, v in d["mean_extra_arguments"].items())
@@ -317,7 +330,8 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
                            for c, fs in shown) or "none"
         if len(d["missed"]) > len(shown):
             missed += f"; and {len(d['missed']) - len(shown)} more (in the file)"
-        lines.append(f"| `{name}` | {d['weights']} `{d['weights_sha256'][:8]}` ({d['members']} networks) | "
+        fill = "the gained colours" if d.get("fill") == "gained" else "the network"  # files before `fill`: the network
+        lines.append(f"| `{name}` | {d['weights']} `{d['weights_sha256'][:8]}` ({d['members']} networks) | {fill} | "
                      f"{n} ({d['split']}) | {d.get('threshold', 0.55):g} | {d['recalled']} ({d['recall']:.1%}) | {extra} | "
                      f"{missed} |")
     return lines + [""] + [f"- `{n}`: {d.get('date', '?')}, commit {d.get('commit', '?')}; command "

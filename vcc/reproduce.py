@@ -46,7 +46,7 @@ def _rows() -> list[Row]:
                                (1_000_000, "1M", "526 of 546 (525 in the order 0 / order 1 comparison)"),
                                (3_000_000, "3M", "535 of 546 (the programs listed in Fig 2)")):
         rows.append(Row(f"o1-predfix-{tag}", f"order 1, subroutines, predicted arguments + fixation, {tag}",
-                        Settings(budget=budget, order=1, args="predicted+fixation"), paper))
+                        Settings(budget=budget, order=1, args="predicted+fixation", parts=2), paper))
     rows += [
         Row("o1-predicted-0.5M", "order 1, predicted arguments (no fixation guidance), 0.5M",
             Settings(budget=500_000, args="predicted"), "148 of 546 at 0.4M without fixation guidance"),
@@ -139,6 +139,7 @@ def read_row(path: Path) -> dict | None:
         s = {**summary(run, sorted(info.get("examples_sha256", {}))), "complete": False}
     predictor = info.get("predictor_sha256")
     return {**s, "row": row_of(path.name), "lengths_per_iteration": lengths(run.records),
+            "settings": info.get("settings", {}),
             **({"predictor_sha256": predictor} if predictor else {})}
 
 

@@ -284,6 +284,27 @@ def test_a_higher_threshold_passes_fewer_arguments(tmp_path):
     assert all(high["mean_extra_arguments"][f] <= v for f, v in low["mean_extra_arguments"].items())
 
 
+def test_fill_arguments_from_the_gained_colours_recall_the_fills_and_pass_no_extra_one(tmp_path):
+    """`--fill gained` (what the search takes by default): every fill_color argument a
+    reference program uses is recalled and none it does not use passes; the filters are
+    the network's either way."""
+    from vcc.cli import main
+
+    concepts = ("change_all_objs_color,move_all_objs_down,change_red_objs_color,remove_bottom_obj,"
+                "move_right_most_obj_to_top_edge_AND_change_color")
+    runs = {}
+    for fill in ("predicted", "gained"):
+        out = tmp_path / f"{fill}.json"
+        assert main(["argpred", "eval", "--concepts", concepts, "--fill", fill, "--out", str(out), "--show", "0"]) == 0
+        runs[fill] = json.loads(out.read_text())
+        assert runs[fill]["fill"] == fill and ("--fill" in runs[fill]["command"]) == (fill == "gained")
+    gained, network = runs["gained"], runs["predicted"]
+    assert gained["mean_extra_arguments"]["fill_color"] == 0
+    assert not any("fill_color" in miss for miss in gained["missed"].values())
+    for f in ("set_shape_attn", "set_color_attn"):
+        assert gained["mean_extra_arguments"][f] == network["mean_extra_arguments"][f]
+
+
 def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_path, capsys, monkeypatch):
     from argpred import cli as argcli
     from vcc.cli import main
@@ -311,8 +332,10 @@ def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_pat
         (["argpred", "eval", "--concepts", "", "--out", str(res)], "has an empty name"),
         (["argpred", "eval", "--concepts", "no_such", "--out", str(res)], "unknown concept(s): no_such"),
         (["argpred", "eval", "--show", "-1", "--out", str(res)], "argument --show: -1 is out of range"),
-        (["argpred", "eval", "--record", "--concepts", "remove_bottom_obj"], "--record keeps the recall on all"),
-        (["argpred", "eval", "--record", "--threshold", "0.6"], "--record keeps the recall on all"),
+        (["argpred", "eval", "--record", "--concepts", "remove_bottom_obj"], "--record keeps the weights' own recall"),
+        (["argpred", "eval", "--record", "--threshold", "0.6"], "--record keeps the weights' own recall"),
+        (["argpred", "eval", "--record", "--fill", "gained"], "--record keeps the weights' own recall"),
+        (["argpred", "eval", "--fill", "both", "--out", str(res)], "argument --fill: invalid choice"),
         (["argpred", "eval", "--threshold", "0", "--out", str(res)], "argument --threshold: 0 is out of range"),
         (["argpred", "data", "--out", str(d), "--kind", "loops"], "argument --kind: invalid choice"),
         (["argpred", "eval", "--weights", str(tmp_path / "none.msgpack"), "--out", str(res)], "none.msgpack: missing"),

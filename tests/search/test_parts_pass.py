@@ -38,8 +38,8 @@ def ds(tmp_path_factory):
 
 
 def _induce(ds, out, parts: int, concepts=("recolor_top_red_and_bottom_blue", "recolor_bottom_obj_blue"), **kw):
-    return induce(list(concepts), ds.pairs, out, Settings(budget=BUDGET, args="oracle", max_iterations=1, parts=parts,
-                                                       **kw),
+    return induce(list(concepts), ds.pairs, out, Settings(**{"budget": BUDGET, "args": "oracle", "max_iterations": 1,
+                                                          "parts": parts, **kw}),
                   explorer=ScalarExplorer(width=1), progress=False, answers=ds.program, log=lambda _: None)
 
 
@@ -121,4 +121,31 @@ def test_a_bad_parts_value_is_one_line(tmp_path, capsys, value):
     assert main(["induce", "--concepts", "demo", "--out", str(tmp_path / "r"), "--parts", value]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--parts" in err[0]
+    assert not (tmp_path / "r").exists()
+
+
+def test_a_run_recorded_before_fill_took_the_networks_fill_arguments_and_resumes_so_only(ds, tmp_path):
+    """run.json written before `fill` existed took fill_color's arguments from the network:
+    with predicted arguments it resumes with `fill="predicted"` only; the setting means
+    nothing to oracle arguments, so there any resumes."""
+    from search.induce import same_search
+
+    out = tmp_path / "run"
+    _induce(ds, out, parts=1, args="predicted", fill="predicted", concepts=["recolor_bottom_obj_blue"])
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["settings"].pop("fill") == "predicted"
+    (out / "run.json").write_text(json.dumps(meta))
+    _induce(ds, out, parts=1, args="predicted", fill="predicted", concepts=["recolor_bottom_obj_blue"])
+    with pytest.raises(DataFileError, match="other settings"):
+        _induce(ds, out, parts=1, args="predicted", concepts=["recolor_bottom_obj_blue"])  # fill gained
+    old_oracle = {k: v for k, v in Settings(args="oracle").__dict__.items() if k != "fill"}
+    assert same_search(old_oracle, Settings(args="oracle", fill="gained").__dict__)
+    assert not same_search({**old_oracle, "args": "predicted"}, Settings(args="predicted").__dict__)
+
+
+@pytest.mark.parametrize("option,value", [("--fill", "both"), ("--fill", "")])
+def test_a_bad_fill_is_one_line(tmp_path, capsys, option, value):
+    assert main(["induce", "--concepts", "demo", "--out", str(tmp_path / "r"), option, value]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and option in err[0]
     assert not (tmp_path / "r").exists()

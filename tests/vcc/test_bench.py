@@ -278,6 +278,9 @@ def test_the_report_gives_the_predictors_recall_and_extra_arguments():
     higher = next(x for x in argpred_section([("argpred-recall-0.6.json", {**d, "threshold": 0.6})])
                   if x.startswith("| `argpred-recall-0.6.json`"))
     assert "| 0.6 | 6 (" in higher
+    assert "| the network | 8 (train) |" in row  # a file written before `fill` was recorded
+    gained = next(x for x in argpred_section([("g.json", {**d, "fill": "gained"})]) if x.startswith("| `g.json`"))
+    assert "| the gained colours | 8 (train) |" in gained
     many = {**d, "missed": {f"c{k}": {"fill_color": ["red"]} for k in range(11)}}
     long_row = next(x for x in argpred_section([("m.json", many)]) if x.startswith("| `m.json`"))
     assert "c7: fill_color(red)" in long_row and "c8:" not in long_row and "and 3 more (in the file)" in long_row
