@@ -50,7 +50,9 @@ def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
     """log p(argument | instruction) under `mode` (see the module's docstring). `answer`
     is needed by oracle and, without `fixate`, by +fixation; `pairs` by predicted, which
     keeps the arguments at or above `threshold` (default the paper's 0.55) and takes
-    `fill_color`'s as `fill` says ('gained' or 'predicted')."""
+    `fill_color`'s as `fill` says ('gained' or 'predicted'). With `fallback`, a predicted
+    function none of whose arguments pass keeps the network's probabilities instead of
+    being left out; fill_color read from the pairs is exact and has none to fall back on."""
     if mode not in MODES:
         raise ValueError(f"--args must be one of {', '.join(MODES)}, got {mode!r}")
     out = uniform_args()
@@ -67,7 +69,8 @@ def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
 
         probs = with_fill(default_predictor().for_pairs(pairs), pairs, fill)
         for name, lp in predicted(probs, THRESHOLD if threshold is None else threshold).items():
-            if fallback and not np.isfinite(lp).any():
+            exact = name == "fill_color" and fill == "gained"
+            if fallback and not exact and not np.isfinite(lp).any():
                 p = np.asarray(probs[name], np.float64)
                 lp = np.log(p / p.sum())
             out[OP[name]] = lp

@@ -83,6 +83,11 @@ def test_the_search_takes_fill_arguments_from_the_pairs_by_default_or_from_the_n
     moved = [(before, _scene((SQ, "red", 0.8, 0.5), (CI, "green", 0.5, 0.5)))] * 3
     assert not np.isfinite(argument_logp("predicted+fixation", moved, parse("scene_parse; top_down_attend"))[
         OP["fill_color"]]).any()  # nothing gained: fill_color left out of the search
+    # `vcc learn` falls back on the network where no argument passes; not for the exact rule
+    lp = argument_logp("predicted", moved, fallback=True)[OP["fill_color"]]
+    assert (lp == -np.inf).all()
+    for op, v in argument_logp("predicted", moved, fallback=True).items():
+        assert not np.isnan(v).any(), op
     from argpred.predict import THRESHOLD, default_predictor
 
     network = default_predictor().for_pairs(moved)["fill_color"]
