@@ -34,13 +34,14 @@ def _commit() -> str | None:
 
 def _eval_command(weights: str | None = None, concepts: str = "all", dataset: str | None = None,
                   out: str | None = None, record: bool = False, threshold: float = 0.55,
-                  fill: str = "predicted") -> str:
+                  fill: str = "predicted", filters: str = "network") -> str:
     """The `vcc argpred eval` command line that measures this (options left at their
     defaults are left out)."""
     parts = ["vcc", "argpred", "eval"]
     for flag, value, default in (("--weights", weights, None), ("--concepts", concepts, "all"),
                                  ("--dataset", dataset, None), ("--threshold", threshold, 0.55),
-                                 ("--fill", fill, "predicted"), ("--out", out, None)):
+                                 ("--fill", fill, "predicted"), ("--filters", filters, "network"),
+                                 ("--out", out, None)):
         if value != default:
             parts += [flag, str(value)]
     return shlex.join(parts + (["--record"] if record else []))
@@ -127,17 +128,19 @@ def cmd_recall(a: argparse.Namespace) -> int:
     from vccjax.world.concepts import concept_list
 
     names = concept_list(a.concepts)
-    if a.record and (a.concepts != "all" or a.dataset or a.threshold != 0.55 or a.fill != "predicted"):
+    if a.record and (a.concepts != "all" or a.dataset or a.threshold != 0.55 or a.fill != "predicted"
+                     or a.filters != "network"):
         raise ValueError("--record keeps the weights' own recall on all the concepts' shipped examples at 0.55 in "
-                         "the weights card: leave out --concepts, --dataset, --threshold and --fill")
+                         "the weights card: leave out --concepts, --dataset, --threshold, --fill and --filters")
     start = time.time()
-    r, card = measure(a.weights, names, a.dataset, a.threshold, a.fill)
+    r, card = measure(a.weights, names, a.dataset, a.threshold, a.fill, a.filters)
     seconds = time.time() - start
     date = _now()
     if a.out:
         _write_json(Path(a.out), {
             "benchmark": "argpred-recall", "date": date, "commit": _commit(),
-            "command": _eval_command(a.weights, a.concepts, a.dataset, a.out, a.record, a.threshold, a.fill),
+            "command": _eval_command(a.weights, a.concepts, a.dataset, a.out, a.record, a.threshold, a.fill,
+                                     a.filters),
             "weights": a.weights or "shipped", "weights_sha256": card["sha256"],
             "members": card["model"].get("members", 1), "dataset": a.dataset or "shipped", "split": "train",
             "seconds": round(seconds, 2), **r})
@@ -230,6 +233,10 @@ def add_commands(sub) -> None:
                    help="fill_color's arguments: 'predicted' by the network (default: the weights' own figures) "
                         "or 'gained', the colours some object gains in the pairs (what `vcc induce` searches "
                         "with by default; argpred.gained)")
+    e.add_argument("--filters", choices=["network", "acted"], default="network",
+                   help="the filters' arguments: the network's alone (default: the weights' own figures) or "
+                        "'acted', less the values the objects acted on rule out (what `vcc induce` searches "
+                        "with by default; argpred.acted)")
     e.add_argument("--out", "--json", dest="out", type=runtime.out_file(".json"),
                    help="write the result JSON here: recall, concepts recalled, misses, mean extra arguments "
                         "per function, the weights' sha256, date, commit and command")

@@ -10,6 +10,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from argpred.acted import with_filters
 from argpred.data import PREDICTED
 from argpred.gained import with_fill
 from argpred.predict import THRESHOLD, Predictor, passing
@@ -29,15 +30,17 @@ def used_arguments(concept: str) -> dict[str, set[str]]:
 
 def recall(predictor: Predictor, concepts: Sequence[str],
            pairs: Callable[[str], list[tuple[Scene, Scene]]], threshold: float = THRESHOLD,
-           fill: str = "predicted") -> dict:
+           fill: str = "predicted", filters: str = "network") -> dict:
     """Recall and extra arguments; `fill` 'gained' takes fill_color's from the pairs
-    (`argpred.gained`), as the search does by default."""
+    (`argpred.gained`), `filters` 'acted' drops the filter values the objects acted on rule
+    out (`argpred.acted`), as the search does by default."""
     missed: dict[str, dict[str, list[str]]] = {}
     extra = {f: [] for f in PREDICTED}
     extras: dict[str, dict[str, list[str]]] = {}  # per concept, the arguments passed that it never uses
     unused, kept = dict.fromkeys(PREDICTED, 0), dict.fromkeys(PREDICTED, 0)
     for c in concepts:
-        ok = passing(with_fill(predictor.for_pairs(pairs(c)), pairs(c), fill), threshold)
+        ok = passing(with_filters(with_fill(predictor.for_pairs(pairs(c)), pairs(c), fill), pairs(c), filters),
+                     threshold)
         used = used_arguments(c)
         miss = {f: sorted(used[f] - set(ok[f])) for f in PREDICTED if used[f] - set(ok[f])}
         if miss:
@@ -51,7 +54,7 @@ def recall(predictor: Predictor, concepts: Sequence[str],
                 unused[f] += 1
                 kept[f] += bool(ok[f])
     return {
-        "concepts": len(concepts), "threshold": threshold, "fill": fill, "recalled": len(concepts) - len(missed),
+        "concepts": len(concepts), "threshold": threshold, "fill": fill, "filters": filters, "recalled": len(concepts) - len(missed),
         "recall": (len(concepts) - len(missed)) / len(concepts),
         "mean_extra_arguments": {f: float(np.mean(v)) for f, v in extra.items()},
         "unused_function_kept": {f: {"kept": kept[f], "of_concepts_not_using_it": unused[f]} for f in PREDICTED},
@@ -60,7 +63,7 @@ def recall(predictor: Predictor, concepts: Sequence[str],
 
 
 def measure(weights=None, concepts: Sequence[str] | None = None, dataset=None,
-            threshold: float = THRESHOLD, fill: str = "predicted") -> tuple[dict, dict]:
+            threshold: float = THRESHOLD, fill: str = "predicted", filters: str = "network") -> tuple[dict, dict]:
     """(`recall` of the weights at `weights` (default: the shipped ones) on `concepts`
     (default: all 546) with the training pairs of `dataset` (default: the shipped
     examples) at `threshold`, the weights' card)."""
@@ -72,7 +75,7 @@ def measure(weights=None, concepts: Sequence[str] | None = None, dataset=None,
         raise ValueError("no concepts to measure recall on")
     predictor = Predictor(weights)
     ds = dataset_for(names, 0, dataset, progress=False)
-    return recall(predictor, names, lambda c: ds.pairs(c, "train"), threshold, fill), predictor.card
+    return recall(predictor, names, lambda c: ds.pairs(c, "train"), threshold, fill, filters), predictor.card
 
 
 def card_record(r: dict, date: str, command: str) -> dict:

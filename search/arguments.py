@@ -6,8 +6,9 @@ Modes (`vcc induce --args`, `vcc learn`):
 - predicted: `set_shape_attn` and `set_color_attn` from the argument CNN on the training
   pairs (arguments under 0.55 dropped, an instruction with none left out;
   `argpred.predict`); `fill_color` the colours some object gains in the pairs
-  (`argpred.gained`; `fill="predicted"`: from the CNN as the filters); `fixate` and
-  `imagine_object` uniform;
+  (`argpred.gained`; `fill="predicted"`: from the CNN as the filters); the filters'
+  values the objects acted on rule out dropped (`argpred.acted`; `filters="network"`:
+  the CNN's alone); `fixate` and `imagine_object` uniform;
 - oracle: uniform over the values an answer program uses, an instruction with arguments
   it never uses left out (what a perfect predictor gives; a research setting that reads
   the answer, never a default);
@@ -46,13 +47,16 @@ def used_values(program: Program, name: str) -> list[int]:
 
 def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None, answer: Program | None = None,
                   fixate: Sequence[str] | None = None, fallback: bool = False,
-                  threshold: float | None = None, fill: str = "gained") -> dict[int, np.ndarray]:
+                  threshold: float | None = None, fill: str = "gained",
+                  filters: str = "acted") -> dict[int, np.ndarray]:
     """log p(argument | instruction) under `mode` (see the module's docstring). `answer`
     is needed by oracle and, without `fixate`, by +fixation; `pairs` by predicted, which
     keeps the arguments at or above `threshold` (default the paper's 0.55) and takes
-    `fill_color`'s as `fill` says ('gained' or 'predicted'). With `fallback`, a predicted
-    function none of whose arguments pass keeps the network's probabilities instead of
-    being left out; fill_color read from the pairs is exact and has none to fall back on."""
+    `fill_color`'s as `fill` says ('gained' or 'predicted'), the filters' as `filters`
+    says ('acted' or 'network'). With `fallback`, a predicted function none of whose
+    arguments pass keeps the network's probabilities instead of being left out; a
+    function the pairs' rules leave no value (fill_color read from the pairs is exact)
+    has none to fall back on."""
     if mode not in MODES:
         raise ValueError(f"--args must be one of {', '.join(MODES)}, got {mode!r}")
     out = uniform_args()
@@ -65,14 +69,16 @@ def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
 
         if not pairs:
             raise ValueError("--args predicted needs the concept's training pairs")
+        from argpred.acted import with_filters
         from argpred.gained import with_fill
 
-        probs = with_fill(default_predictor().for_pairs(pairs), pairs, fill)
+        probs = with_filters(with_fill(default_predictor().for_pairs(pairs), pairs, fill), pairs, filters)
         for name, lp in predicted(probs, THRESHOLD if threshold is None else threshold).items():
             exact = name == "fill_color" and fill == "gained"
-            if fallback and not exact and not np.isfinite(lp).any():
-                p = np.asarray(probs[name], np.float64)
-                lp = np.log(p / p.sum())
+            p = np.asarray(probs[name], np.float64)
+            if fallback and not exact and not np.isfinite(lp).any() and p.sum() > 0:
+                with np.errstate(divide="ignore"):  # a value the pairs rule out stays out
+                    lp = np.log(p / p.sum())
             out[OP[name]] = lp
     if mode.endswith("+fixation"):
         if fixate is not None:

@@ -16,7 +16,7 @@ def cmd_induce(a: argparse.Namespace) -> int:
     runtime.on_cluster(a)
     settings = Settings(budget=a.budget, order=a.order, args=a.args, subroutines=a.subroutines == "on",
                         epsilon=a.epsilon, max_iterations=a.iterations, parts=a.parts,
-                        arg_threshold=a.arg_threshold, fill=a.fill)
+                        arg_threshold=a.arg_threshold, fill=a.fill, filters=a.filters)
     if a.dataset:  # any built dataset: the concepts its manifest holds, their stored programs as answers
         from vccjax.world.dataset import Dataset
 
@@ -134,6 +134,10 @@ def add_commands(sub) -> None:
                    help="with --args predicted: fill_color's arguments are the colours some object gains in the "
                         "pairs (default; exact: only fill_color changes a colour), or 'predicted' by the network "
                         "as the filters (the paper's)")
+    p.add_argument("--filters", choices=["acted", "network"], default="acted",
+                   help="with --args predicted: drop the shape and colour filter values the objects acted on rule "
+                        "out (default; where one pair changes three or more kinds of objects, only values of an "
+                        "object left in place stay), or 'network': the network's filters alone (the paper's)")
     p.add_argument("--parts", type=runtime.count(1, 3), default=1,
                    help="2 or 3: after the iterations, a last pass over the concepts still missed, each "
                         "searched whole with the model of everything found and, where that fails, in up to "

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from argpred.acted import FILTER_MODES
 from argpred.gained import FILL_MODES
 from search.arguments import MODES as ARG_MODES
 from search.chain import Chain
@@ -56,6 +57,7 @@ class Settings:
     parts: int = 1  # >= 2: a last pass over missed concepts, whole then in up to this many parts (1: none)
     arg_threshold: float = 0.55  # predicted arguments pass at this probability (the paper's 0.55)
     fill: str = "gained"  # predicted modes: fill_color's arguments from the colours objects gain, or "predicted"
+    filters: str = "acted"  # predicted modes: filter values the objects acted on rule out dropped, or "network"
 
     def __post_init__(self) -> None:
         if self.args not in ARG_MODES:
@@ -70,6 +72,8 @@ class Settings:
             raise ValueError(f"--arg-threshold must be above 0 and at most 1, got {self.arg_threshold}")
         if self.fill not in FILL_MODES:
             raise ValueError(f"--fill must be one of {', '.join(FILL_MODES)}, got {self.fill!r}")
+        if self.filters not in FILTER_MODES:
+            raise ValueError(f"--filters must be one of {', '.join(FILTER_MODES)}, got {self.filters!r}")
 
 
 def needs_answer(settings: Settings) -> bool:
@@ -86,7 +90,8 @@ def argument_logp(settings: Settings, concept: str, pairs: Sequence[tuple[Scene,
 
     if answer is None and needs_answer(settings):
         answer = reference_program(concept)
-    return logp(settings.args, pairs, answer, threshold=settings.arg_threshold, fill=settings.fill)
+    return logp(settings.args, pairs, answer, threshold=settings.arg_threshold, fill=settings.fill,
+                filters=settings.filters)
 
 
 def fit_model(programs: Sequence[Program], settings: Settings, with_subroutines: bool):
@@ -225,13 +230,15 @@ def same_search(recorded: object, mine: dict) -> bool:
     which only adds a pass after the iterations (a folder written before it existed
     holds none), so a finished run may be resumed to add it. A folder written before
     `arg_threshold` existed searched at 0.55, one written before `fill` took fill_color's
-    arguments from the network; `fill` matters only to predicted arguments."""
+    arguments from the network, one written before `filters` the network's filters;
+    `fill` and `filters` matter only to predicted arguments."""
     if not isinstance(recorded, dict):
         return False
-    a = {"arg_threshold": 0.55, "fill": "predicted", **recorded, "parts": 0}
+    a = {"arg_threshold": 0.55, "fill": "predicted", "filters": "network", **recorded, "parts": 0}
     b = {**mine, "parts": 0}
     if not str(b.get("args", "")).startswith("predicted"):
-        a.pop("fill"), b.pop("fill", None)
+        for k in ("fill", "filters"):
+            a.pop(k), b.pop(k, None)
     return a == b
 
 

@@ -80,7 +80,8 @@ def why_missed(folder: Path, others: list[Path] = (), model_index: int | None = 
     for c in missed:
         answer = reference_program(c)
         logp = argument_logp(settings["args"], ds.pairs(c, "train"), answer,
-                             threshold=settings.get("arg_threshold", 0.55), fill=settings.get("fill", "predicted"))
+                             threshold=settings.get("arg_threshold", 0.55), fill=settings.get("fill", "predicted"),
+                             filters=settings.get("filters", "network"))
         chain = Chain(vocab, model, logp, float(settings.get("delta", 0.01)))
         row = {"concept": c, "instructions": len(answer.ops)}
 

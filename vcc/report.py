@@ -94,12 +94,14 @@ def _pass(settings: dict) -> str:
 def _predicted(settings: dict) -> str:
     """With predicted arguments: a threshold other than the paper's 0.55, and fill_color's
     arguments from the colours objects gain (`--fill gained`; folders written before
-    `fill` existed took them from the network)."""
+    `fill` existed took them from the network), filter values the objects acted on rule
+    out dropped (`--filters acted`; before `filters`: the network's alone)."""
     if not str(settings.get("args", "")).startswith("predicted"):
         return ""
     t = settings.get("arg_threshold", 0.55)
     return ((f", threshold {t:g}" if t != 0.55 else "")
-            + (", fill_color from the colours objects gain" if settings.get("fill") == "gained" else ""))
+            + (", fill_color from the colours objects gain" if settings.get("fill") == "gained" else "")
+            + (", filters the objects acted on rule out dropped" if settings.get("filters") == "acted" else ""))
 
 
 def _weights(s: dict | None) -> str:
@@ -320,8 +322,9 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
     if not runs:
         return []
     lines = ["## Argument predictor: recall and extra arguments (`vcc argpred eval`)", "",
-             "| file | weights | fill_color from | concepts (split) | threshold | recalled: every used argument passes | "
-             "mean extra arguments per concept, by function | not recalled |", "|---|---|---|---|---|---|---|---|"]
+             "| file | weights | fill_color from | filters | concepts (split) | threshold | recalled: every used argument "
+             "passes | mean extra arguments per concept, by function | not recalled |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for name, d in runs:
         n = d["concepts"] if isinstance(d["concepts"], int) else len(d["concepts"])
         extra = ", ".join(f"{f} {v:.2f}" for f, v in d["mean_extra_arguments"].items())
@@ -331,7 +334,9 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
         if len(d["missed"]) > len(shown):
             missed += f"; and {len(d['missed']) - len(shown)} more (in the file)"
         fill = "the gained colours" if d.get("fill") == "gained" else "the network"  # files before `fill`: the network
+        filters = "less those the objects acted on rule out" if d.get("filters") == "acted" else "the network"
         lines.append(f"| `{name}` | {d['weights']} `{d['weights_sha256'][:8]}` ({d['members']} networks) | {fill} | "
+                     f"{filters} | "
                      f"{n} ({d['split']}) | {d.get('threshold', 0.55):g} | {d['recalled']} ({d['recall']:.1%}) | {extra} | "
                      f"{missed} |")
     return lines + [""] + [f"- `{n}`: {d.get('date', '?')}, commit {d.get('commit', '?')}; command "

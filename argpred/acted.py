@@ -1,0 +1,69 @@
+"""Attention filters checked against the pairs: which shape and colour filter values the
+objects a concept acts on leave possible.
+
+A shape (colour) filter makes `top_down_attend` attend objects of that one shape
+(colour), and every instruction that changes an object acts on the attended one
+(docs/vcc.md, sections 3 and 11). So a program that sets a shape filter once or twice
+changes, in any one pair, objects of at most two shapes through it. Where the objects a
+pair changes (moved, recoloured or removed: no object of the same shape and colour left
+at their place) are of three or more shapes, they were changed by a part with no shape
+filter; a shape filter can then only have picked an object that is left as it was, a
+landmark ("move every object to the red one"). So the values kept are those of which
+some object stays put in every pair. The network cannot see this: it sees each grid
+cell on its own, and reads "a diamond changed" as "a diamond filter" where every object
+changed (docs/argpred.md, "Filters the objects acted on rule out").
+
+Unlike `argpred.gained`, this is not exact: a concept that acts on some objects through
+a filter and on three or more kinds of objects with none ("the squares left, then every
+object up") loses the filter. Searches take it by default (`--filters acted`);
+`--filters network` searches with the network's filters alone.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from vccjax.machine.config import DEFAULT_CONFIG
+from vccjax.machine.instructions import COLORS, SHAPES
+from vccjax.machine.scene import Scene, SceneObject
+
+FILTER_MODES = ("acted", "network")  # acted: this rule on top of the network; network: the network alone
+SPAN = 3  # kinds of objects changed in one pair that no one or two filters of that attribute explain
+_FILTERS = {"set_shape_attn": ("shape", SHAPES), "set_color_attn": ("color", COLORS)}
+
+
+def stays(o: SceneObject, after: Scene, tau: float) -> bool:
+    """Whether an object of the same shape and colour sits at `o`'s place in `after`."""
+    return any(p.shape == o.shape and p.color == o.color and abs(p.x - o.x) <= tau and abs(p.y - o.y) <= tau
+               for p in after.objects)
+
+
+def allowed_values(pairs: Sequence[tuple[Scene, Scene]], tau: float = DEFAULT_CONFIG.tau) -> dict[str, set[str] | None]:
+    """Per filter instruction, the values the pairs leave possible (None: any value)."""
+    out: dict[str, set[str] | None] = {}
+    for name, (attr, _) in _FILTERS.items():
+        changed = [{getattr(o, attr) for o in a.objects if not stays(o, b, tau)} for a, b in pairs]
+        if not pairs or max(len(c) for c in changed) < SPAN:
+            out[name] = None
+            continue
+        kept = [{getattr(o, attr) for o in a.objects if stays(o, b, tau)} for a, b in pairs]
+        out[name] = set.intersection(*kept)
+    return out
+
+
+def with_filters(probs: dict[str, np.ndarray], pairs: Sequence[tuple[Scene, Scene]], filters: str,
+                 tau: float = DEFAULT_CONFIG.tau) -> dict[str, np.ndarray]:
+    """The predictor's probabilities with the filter values the pairs rule out set to 0
+    (`filters` 'acted'), or unchanged ('network')."""
+    if filters not in FILTER_MODES:
+        raise ValueError(f"--filters must be one of {', '.join(FILTER_MODES)}, got {filters!r}")
+    if filters == "network":
+        return probs
+    out = dict(probs)
+    for name, values in allowed_values(pairs, tau).items():
+        if values is not None and name in out:
+            domain = _FILTERS[name][1]
+            out[name] = np.where([v in values for v in domain], np.asarray(out[name], np.float64), 0.0)
+    return out
