@@ -36,9 +36,10 @@ STARTS = ("library", "uniform")
 # and what the library's search misses is tried from a uniform start over a tenth of the
 # budget before the parts (`search.learn.from_uniform`); 5: when no join of parts fits,
 # graded first parts continued from the machine state they leave (`search.parts.continued`);
-# 6: fill_color's arguments from the colours objects gain (`argpred.gained`), not the network
+# 6: fill_color's arguments from the colours objects gain (`argpred.gained`), not the network;
+# 7: filter values the objects acted on rule out dropped (`argpred.acted`)
 # (a run of another protocol is refused)
-PROTOCOL = 6
+PROTOCOL = 7
 # What every results line must hold (the key of `_key`, and whether it was found).
 RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 

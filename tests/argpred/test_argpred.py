@@ -305,6 +305,28 @@ def test_fill_arguments_from_the_gained_colours_recall_the_fills_and_pass_no_ext
         assert gained["mean_extra_arguments"][f] == network["mean_extra_arguments"][f]
 
 
+def test_filters_the_objects_acted_on_rule_out_drop_extra_filters_and_no_used_one(tmp_path):
+    """`--filters acted` (what the search takes by default) on concepts that act on every
+    object and on filtered ones: the loops lose the filters the network passes them,
+    and no concept loses a filter value its program uses."""
+    from vcc.cli import main
+
+    concepts = "change_all_objs_color,move_all_objs_down,change_red_objs_color,move_all_yellow_left"
+    runs = {}
+    for filters in ("network", "acted"):
+        out = tmp_path / f"{filters}.json"
+        assert main(["argpred", "eval", "--concepts", concepts, "--fill", "gained", "--filters", filters,
+                     "--out", str(out), "--show", "0"]) == 0
+        runs[filters] = json.loads(out.read_text())
+        assert runs[filters]["filters"] == filters and ("--filters" in runs[filters]["command"]) == (filters == "acted")
+    acted, network = runs["acted"], runs["network"]
+    assert acted["recalled"] == network["recalled"]
+    for c in ("change_all_objs_color", "move_all_objs_down"):
+        assert c in network["extra_arguments"] and c not in acted["extra_arguments"]
+    assert sum(acted["mean_extra_arguments"][f] for f in ("set_shape_attn", "set_color_attn")) < \
+        sum(network["mean_extra_arguments"][f] for f in ("set_shape_attn", "set_color_attn"))
+
+
 def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_path, capsys, monkeypatch):
     from argpred import cli as argcli
     from vcc.cli import main
@@ -336,6 +358,8 @@ def test_argpred_commands_refuse_bad_options_in_one_line_writing_nothing(tmp_pat
         (["argpred", "eval", "--record", "--threshold", "0.6"], "--record keeps the weights' own recall"),
         (["argpred", "eval", "--record", "--fill", "gained"], "--record keeps the weights' own recall"),
         (["argpred", "eval", "--fill", "both", "--out", str(res)], "argument --fill: invalid choice"),
+        (["argpred", "eval", "--record", "--filters", "acted"], "--record keeps the weights' own recall"),
+        (["argpred", "eval", "--filters", "both", "--out", str(res)], "argument --filters: invalid choice"),
         (["argpred", "eval", "--threshold", "0", "--out", str(res)], "argument --threshold: 0 is out of range"),
         (["argpred", "data", "--out", str(d), "--kind", "loops"], "argument --kind: invalid choice"),
         (["argpred", "eval", "--weights", str(tmp_path / "none.msgpack"), "--out", str(res)], "none.msgpack: missing"),

@@ -143,7 +143,30 @@ def test_a_run_recorded_before_fill_took_the_networks_fill_arguments_and_resumes
     assert not same_search({**old_oracle, "args": "predicted"}, Settings(args="predicted").__dict__)
 
 
-@pytest.mark.parametrize("option,value", [("--fill", "both"), ("--fill", "")])
+def test_a_run_recorded_before_filters_searched_the_networks_filters_and_resumes_so_only(ds, tmp_path):
+    """run.json written before `filters` existed searched with the network's filters alone:
+    with predicted arguments it resumes with `filters="network"` only; oracle arguments
+    take no filter from the network, so there any resumes."""
+    from search.induce import same_search
+
+    out = tmp_path / "run"
+    one = ["recolor_bottom_obj_blue"]
+    _induce(ds, out, parts=1, args="predicted", filters="network", concepts=one)
+    meta = json.loads((out / "run.json").read_text())
+    assert meta["settings"].pop("filters") == "network"
+    (out / "run.json").write_text(json.dumps(meta))
+    _induce(ds, out, parts=1, args="predicted", filters="network", concepts=one)
+    with pytest.raises(DataFileError, match="other settings"):
+        _induce(ds, out, parts=1, args="predicted", concepts=one)  # filters acted
+    old_oracle = {k: v for k, v in Settings(args="oracle").__dict__.items() if k != "filters"}
+    assert same_search(old_oracle, Settings(args="oracle", filters="acted").__dict__)
+    assert not same_search({**old_oracle, "args": "predicted"}, Settings(args="predicted").__dict__)
+    with pytest.raises(ValueError, match="--filters must be one of"):
+        Settings(filters="both")
+
+
+@pytest.mark.parametrize("option,value", [("--fill", "both"), ("--fill", ""), ("--filters", "both"),
+                                          ("--filters", "")])
 def test_a_bad_fill_is_one_line(tmp_path, capsys, option, value):
     assert main(["induce", "--concepts", "demo", "--out", str(tmp_path / "r"), option, value]) == 2
     err = capsys.readouterr().err.strip().splitlines()
