@@ -40,6 +40,7 @@ LIBRARIES = ("shipped", "uniform")  # or a library file's path
 class LearnSettings:
     budget: int = 500_000  # programs searched for the first fit, at most
     args: str = "predicted"  # or "uniform"
+    filters: str = "acted"  # predicted: filter values the objects acted on rule out dropped, or "network"
     fixate: tuple[str, ...] | None = None  # the teacher's hint: fixate only to these
     library: str = "shipped"  # "shipped", "uniform" (from scratch) or a library file
     rival_margin_nats: float = 6.0  # rivals at most this much less probable than the first
@@ -55,6 +56,8 @@ class LearnSettings:
     def __post_init__(self) -> None:
         if self.args not in ("predicted", "uniform"):
             raise ValueError(f"--args must be predicted or uniform, got {self.args!r}")
+        if self.filters not in ("acted", "network"):
+            raise ValueError(f"--filters must be acted or network, got {self.filters!r}")
         if self.budget < 1:
             raise ValueError(f"--budget must be positive, got {self.budget}")
         if not 1 <= self.parts <= 5:
@@ -125,7 +128,8 @@ def chain_for(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings,
     """The search's chain for these pairs: the start model and the argument beliefs."""
     vocab, model, name = start or model_for(settings.library)
     mode = settings.args + ("+fixation" if settings.fixate else "")
-    return Chain(vocab, model, argument_logp(mode, pairs, None, settings.fixate, fallback=True), settings.delta), name
+    return Chain(vocab, model, argument_logp(mode, pairs, None, settings.fixate, fallback=True,
+                                             filters=settings.filters), settings.delta), name
 
 
 def alternatives_for(chain: Chain, settings: LearnSettings, budget: int,

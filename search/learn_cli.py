@@ -32,7 +32,7 @@ def _settings(a: argparse.Namespace):
         bad = [v for v in fixate if v not in FIXATE_TARGETS] or ([] if fixate else [a.fixate])
         if bad:
             raise VCCError(f"--fixate {a.fixate}: each value must be one of {', '.join(FIXATE_TARGETS)}")
-    return LearnSettings(budget=a.budget, args=a.args, fixate=fixate, library=a.library,
+    return LearnSettings(budget=a.budget, args=a.args, filters=a.filters, fixate=fixate, library=a.library,
                          rival_budget=a.rival_budget, fresh_scenes=a.fresh_scenes, seed=a.seed, parts=a.parts)
 
 
@@ -55,7 +55,8 @@ def concept_record(learned, examples: list[tuple[str, object, object]], files: l
         "library": learned.library, "examples": files,
         "search": {"rank": r.rank, "programs_judged": r.programs, "seconds": round(r.seconds, 3),
                    "compile_seconds": round(r.compile_seconds, 3), "budget": r.budget},
-        "settings": {"budget": settings.budget, "args": settings.args, "fixate": settings.fixate,
+        "settings": {"budget": settings.budget, "args": settings.args, "filters": settings.filters,
+                     "fixate": settings.fixate,
                      "library": settings.library, "rival_budget": settings.rival_budget, "seed": settings.seed,
                      "parts": settings.parts},
     }
@@ -248,6 +249,11 @@ def add_commands(sub) -> None:
                         "what a library's search misses is searched from scratch over a tenth of the budget")
     p.add_argument("--args", choices=["predicted", "uniform"], default="predicted",
                    help="arguments: predicted by the CNN from the pairs (default) or uniform")
+    p.add_argument("--filters", choices=["acted", "network"], default="acted",
+                   help="with --args predicted: drop the filter values the objects acted on rule out (default; "
+                        "where one pair changes three or more kinds of objects, only the values of an object left "
+                        "in place stay), or 'network': the network's filters alone, for a concept that acts on "
+                        "some objects through a filter and on many kinds with none")
     p.add_argument("--fixate", help="the teacher's hint: where to look first (left, right, top, bottom, center; "
                                     "several comma-separated)")
     p.add_argument("--rival-budget", type=runtime.count(0, 10**10), default=2_000_000,

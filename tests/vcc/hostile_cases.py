@@ -680,3 +680,4 @@ for name in ("foreign", "manifest_list"):
     case(f"bench-learn-dataset-{name.replace('_', '-')}", "bench", "learn",
          *_flags(BL, dataset=f"{{tmp}}/ds/{name}"), setup=["progs", "ds"],
          writes=[f"{{tmp}}/ds/{name}", "{tmp}/bl.json"])
+case("learn-filters-bad", "learn", EXOK, *_flags(LE, filters="some"), setup="examples", writes=W_OUT)
