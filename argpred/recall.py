@@ -54,7 +54,8 @@ def recall(predictor: Predictor, concepts: Sequence[str],
                 unused[f] += 1
                 kept[f] += bool(ok[f])
     return {
-        "concepts": len(concepts), "threshold": threshold, "fill": fill, "filters": filters, "recalled": len(concepts) - len(missed),
+        "concepts": len(concepts), "threshold": threshold, "fill": fill, "filters": filters,
+        "recalled": len(concepts) - len(missed),
         "recall": (len(concepts) - len(missed)) / len(concepts),
         "mean_extra_arguments": {f: float(np.mean(v)) for f, v in extra.items()},
         "unused_function_kept": {f: {"kept": kept[f], "of_concepts_not_using_it": unused[f]} for f in PREDICTED},
