@@ -280,7 +280,10 @@ def test_the_report_gives_the_predictors_recall_and_extra_arguments():
     assert "| 0.6 | 6 (" in higher
     assert "| the network | 8 (train) |" in row  # a file written before `fill` was recorded
     gained = next(x for x in argpred_section([("g.json", {**d, "fill": "gained"})]) if x.startswith("| `g.json`"))
-    assert "| the gained colours | 8 (train) |" in gained
+    assert "| the gained colours | the network | 8 (train) |" in gained  # before `filters`: the network's
+    acted = next(x for x in argpred_section([("a.json", {**d, "fill": "gained", "filters": "acted"})])
+                 if x.startswith("| `a.json`"))
+    assert "| the gained colours | less those the objects acted on rule out | 8 (train) |" in acted
     many = {**d, "missed": {f"c{k}": {"fill_color": ["red"]} for k in range(11)}}
     long_row = next(x for x in argpred_section([("m.json", many)]) if x.startswith("| `m.json`"))
     assert "c7: fill_color(red)" in long_row and "c8:" not in long_row and "and 3 more (in the file)" in long_row
@@ -294,6 +297,16 @@ def test_a_run_with_the_last_pass_reads_with_and_without_it():
     assert _cell(s) == "12 of 20 (9 before the last pass, which found 3, 2 of them in parts)"
     assert _cell({**s, "found_in_last_pass": 0}) == "12 of 20"
     assert _pass({"parts": 2}) == ", then a last pass (whole, then in up to 2 parts)" and _pass({}) == ""
+
+
+def test_a_row_says_how_its_predicted_arguments_were_taken():
+    from vcc.report import _predicted
+
+    assert _predicted({"args": "oracle", "fill": "gained", "filters": "acted"}) == ""
+    assert _predicted({"args": "predicted+fixation"}) == ""  # written before fill and filters: the network's
+    both = _predicted({"args": "predicted", "arg_threshold": 0.6, "fill": "gained", "filters": "acted"})
+    assert both == (", threshold 0.6, fill_color from the colours objects gain, "
+                    "filters the objects acted on rule out dropped")
 
 
 def test_bench_emulator_cuts_batches_as_the_search_does():
