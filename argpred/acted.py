@@ -2,21 +2,22 @@
 objects a concept acts on leave possible.
 
 A shape (colour) filter makes `top_down_attend` attend objects of that one shape
-(colour), and every instruction that changes an object acts on the attended one
-(docs/vcc.md, sections 3 and 11). So a program that sets a shape filter once or twice
-changes, in any one pair, objects of at most two shapes through it. Where the objects a
-pair changes (moved, recoloured or removed: no object of the same shape and colour left
-at their place) are of three or more shapes, they were changed by a part with no shape
-filter; a shape filter can then only have picked an object that is left as it was, a
-landmark ("move every object to the red one"). So the values kept are those of which
-some object stays put in every pair. The network cannot see this: it sees each grid
-cell on its own, and reads "a diamond changed" as "a diamond filter" where every object
-changed (docs/argpred.md, "Filters the objects acted on rule out").
+(colour) only (docs/vcc.md, sections 3 and 11), so a program that sets a shape filter
+once or twice changes, in any one pair, objects of at most two shapes through it. Where
+the objects a pair changes (moved, recoloured or removed: no object of the same shape and
+colour left at their place) are of three or more shapes, some part of the program
+changed several kinds with no shape filter (a loop over every object, the pointer, the
+hand's moves). We take that part to be what the concept does; a shape filter can then
+only have picked an object left as it was, a landmark ("move every object to the red
+one"), so the values kept are those of which some object stays put in every pair. The
+network cannot see this: it sees each grid cell on its own, and reads "a diamond
+changed" as "a diamond filter" where every object changed (docs/argpred.md, "Filters
+the objects acted on rule out").
 
 Unlike `argpred.gained`, this is not exact: a concept that acts on some objects through
-a filter and on three or more kinds of objects with none ("the squares left, then every
-object up") loses the filter. Searches take it by default (`--filters acted`);
-`--filters network` searches with the network's filters alone.
+a filter and on several kinds with none ("the squares left, then every object up")
+loses the filter. Searches take it by default (`--filters acted`); `--filters network`
+searches with the network's filters alone.
 """
 
 from __future__ import annotations
