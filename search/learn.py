@@ -26,7 +26,7 @@ from search.chain import Chain
 from search.dfs import Alternatives
 from search.explore import Searcher
 from search.model import MarkovModel, Vocabulary
-from search.parts import PartsSettings, learn_in_parts
+from search.parts import learn_in_parts, parts_settings
 from search.result import Alternative, Result, program_of, rank_of, text_of
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG
@@ -239,7 +239,7 @@ def in_parts(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: L
              log: Callable[[str], None] | None = None) -> tuple[Result, tuple[Program, ...]]:
     """`searched` (a search that found nothing) completed in parts when it can be
     (`search.parts`: each part's search covers a tenth of the budget, all of them together
-    at most the budget again), with the parts. The program's description length and rank
+    at most 1.1 budgets), with the parts. The program's description length and rank
     are those of its cheapest spelling under the chain of the whole pairs (or, where that
     chain rules out an argument a part uses, under the same model with uniform arguments).
     With a rival budget, the other joins that fit every pair come back as the result's
@@ -249,9 +249,8 @@ def in_parts(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: L
     start = start or model_for(settings.library)
     t0 = time.perf_counter()
     got, judged = learn_in_parts(pairs, lambda p: chain_for(p, settings, start)[0], searcher,
-                                 PartsSettings(max_parts=settings.parts, budget=max(1, settings.budget // 10),
-                                               allowance=settings.budget,
-                                               rivals=settings.max_rivals - 1 if settings.rival_budget else 0),
+                                 parts_settings(settings.budget, settings.parts,
+                                                rivals=settings.max_rivals - 1 if settings.rival_budget else 0),
                                  log=log)
     searched = dataclasses.replace(searched, programs=searched.programs + judged,
                                    seconds=searched.seconds + time.perf_counter() - t0)

@@ -29,10 +29,16 @@ leaves, the object still held and attended. "Take the pointed object down, then 
 is then the first part and two more tokens, where a rest searched from a fresh
 `scene_parse` of the scenes made could not pick the held object out again.
 
+Where no continuation fits either, the first parts are tried once more with one
+fixation added (`remembering`): the same scenes made, the fovea left on a place the rest
+can come back to. "Move the central object right, then put another where it was" is
+then the first part with `fixate_attended_object` before the move, and five tokens on.
+
 The first parts are judged on the host by the scalar reference (`ScalarBackend` with
 another judge); the rest is an ordinary search on the caller's searcher. Each search
-covers a tenth of `vcc learn`'s budget, and all of them together at most the budget
-again, so parts cost at most as much as the plain search they follow.
+covers a tenth of `vcc learn`'s budget (a remembering variant's a tenth of that), and
+all of them together at most 1.1 budgets (`parts_settings`), so parts cost about as much
+as the plain search they follow.
 """
 
 from __future__ import annotations
@@ -40,6 +46,8 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Sequence
+
+import numpy as np
 
 from search.ambiguity import outcomes
 from search.chain import Chain
@@ -66,6 +74,14 @@ class PartsSettings:
     margin_nats: float = 8.0  # first parts (and rests' rivals) at most this much less probable than the cheapest
     rivals: int = 0  # other fitting joins to keep, for the question back (0: stop at the first fit)
     continuations: bool = True  # when no join fits, search on from graded first parts' machine states
+    remembering: int = 8  # then first parts with a fixation added (`remembering`), each searched on a tenth of `budget`
+
+
+def parts_settings(budget: int, max_parts: int, rivals: int = 0) -> PartsSettings:
+    """A part's search a tenth of the budget; all parts of a concept at most 1.1 budgets:
+    the budget, and one part's more for the remembering variants."""
+    part = max(1, budget // 10)
+    return PartsSettings(max_parts=max_parts, budget=part, allowance=budget + part, rivals=rivals)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -237,26 +253,83 @@ def continued(whole: Chain, pairs: Sequence[tuple[Scene, Scene]], searcher: Sear
     """([(nats, program, (first part, what follows))] that fit every pair, complete
     programs judged): first parts judged by graded progress (their search already
     taken from `allowance`), each continued by a search of the programs that start with
-    it (`Searcher.search` with a prefix), on the whole pairs and their chain."""
+    it (`Searcher.search` with a prefix), on the whole pairs and their chain. Where none
+    fits, the first parts' `remembering` variants are continued the same way, each on a
+    tenth of a part's budget."""
     firsts, judged = first_parts(whole, pairs, settings, cfg, graded=True)
     task = Task.from_pairs(pairs, cfg)
     fitting: list[tuple[float, Program, tuple[Program, ...]]] = []
-    for first in firsts:
+
+    def go_on(first: Program, budget: int) -> None:
+        nonlocal judged
         spelt = whole.cheapest(first.ops, first.args)
-        if spelt is None or not allowance.take(settings.budget):
-            continue
+        if spelt is None or not allowance.take(budget):
+            return
         if log:
             log(f"first part {first.text()}: what follows, from the machine state it leaves")
         alternatives = (Alternatives(int(math.ceil(settings.margin_nats / whole.delta)), settings.rivals,
-                                     settings.budget) if settings.rivals else None)
-        r = searcher.search(whole, task, settings.budget, alternatives=alternatives, prefix=spelt[1])
+                                     budget) if settings.rivals else None)
+        r = searcher.search(whole, task, budget, alternatives=alternatives, prefix=spelt[1])
         judged += r.programs
         for p in ([r.program] + [a.program for a in r.alternatives]) if r.found else []:
             if fits(p, pairs, cfg) and all(p != f[1] for f in fitting):
                 n = len(first.ops)  # the parts: the first, and what follows it (if anything)
                 parts = (first,) + ((Program(p.ops[n:], p.args[n:]),) if len(p) > n else ())
                 fitting.append((join_nats(whole, p), p, parts))
+
+    for first in firsts:
+        go_on(first, settings.budget)
+    if not fitting and settings.remembering:
+        for variant in remembering(firsts, whole, pairs, cfg)[: settings.remembering]:
+            go_on(variant, max(1, settings.budget // 10))
     return fitting, judged
+
+
+REMEMBERING = ("fixate_attended_object", "fixate_pointer", "fixate_previous", "fixate_next", "fixate")
+
+
+def remembering(firsts: Sequence[Program], chain: Chain, pairs: Sequence[tuple[Scene, Scene]],
+                cfg: VCCConfig = DEFAULT_CONFIG) -> list[Program]:
+    """The first parts with one fixation added, where it leaves the scenes as they were
+    and the fovea (the machine's only memory of a place) elsewhere: cheapest first under
+    `chain`, one per distinct memory left. "Move the central object, then put another
+    where it was" needs its first part to fixate the object before moving it; that
+    part makes the same scenes as the cheaper one without the fixation, so the search
+    for first parts, which tells them apart by their scenes, never keeps it. In the
+    first parts' order (most progress first), each one's variants cheapest first."""
+    inputs = [a for a, _ in pairs]
+    found: list[tuple[int, float, int, Program, tuple]] = []
+    for k, first in enumerate(firsts):
+        scenes = tuple(None if m is None else m[0] for m in _memory(first, inputs, cfg))
+        for pos in range(1, len(first.ops) + 1):
+            for name in REMEMBERING:
+                lp = chain.arg_logp.get(OP[name])
+                for arg in ([0] if lp is None else [int(i) for i in np.nonzero(np.isfinite(lp))[0]]):
+                    v = Program(first.ops[:pos] + (OP[name],) + first.ops[pos:],
+                                first.args[:pos] + (arg,) + first.args[pos:])
+                    spelt = chain.cheapest(v.ops, v.args)
+                    memory = () if spelt is None else _memory(v, inputs, cfg)
+                    if spelt is not None and tuple(None if m is None else m[0] for m in memory) == scenes:
+                        found.append((k, float(spelt[0]), len(found), v, memory))
+    seen = {_memory(f, inputs, cfg) for f in firsts}  # a variant remembering nothing new is its first part
+    out = []
+    for *_, v, memory in sorted(found, key=lambda f: f[:3]):
+        if memory not in seen:
+            seen.add(memory)
+            out.append(v)
+    return out
+
+
+def _memory(program: Program, inputs: Sequence[Scene], cfg: VCCConfig) -> tuple:
+    """Per input, (objects and pointer made, fovea and its history), or None where it fails."""
+    out = []
+    for s in inputs:
+        m = RefMachine(s, cfg, validate=False).run(program)
+        f = m.fovea
+        scene = m.output_scene() if not m.failed else None
+        out.append(None if scene is None else ((scene.objects, scene.pointer),
+                                               (f.position, tuple(f.history), f.history_index)))
+    return tuple(out)
 
 
 def join_nats(chain: Chain, program: Program) -> float:

@@ -10,8 +10,8 @@ ranks far past the budget, while each half, under that model, is among the first
 thousand. Those are then tried with `search.parts.learn_in_parts` (a first part that
 brings every example closer to its output, the rest from what it makes, the join
 checked on every pair by the reference machine), each part's search a tenth of the
-budget and all of them together at most the budget again. So the pass costs at most
-two budgets per missed concept.
+budget and all of them together at most 1.1 budgets. So the pass costs at most 2.1
+budgets per missed concept.
 
 Its records carry the iteration number `max_iterations` (past every iteration's),
 `last_pass` and `parts` (how many; 0 when found whole); a resume skips the concepts it
@@ -29,7 +29,7 @@ from search.explore import Explorer, Searcher
 from search.induce import (Run, Settings, argument_logp, fit_model, generalization, needs_answer, record_of,
                            write_model)
 from search.model import MarkovModel, Vocabulary
-from search.parts import PartsSettings, learn_in_parts
+from search.parts import learn_in_parts, parts_settings
 from search.result import Result, rank_of, text_of
 from search.task import Task
 from vccjax.machine.config import DEFAULT_CONFIG
@@ -97,11 +97,6 @@ def parts_pass(run: Run, concepts: Sequence[str], pairs: Callable[[str, str], Pa
     new = [r for r in run.records if r["iteration"] == it and r["found"]]
     log(f"last pass: {len(new)} new ({sum(1 for r in new if r['parts'])} in parts), "
         f"{len(run.found())} of {len(set(concepts))} found")
-
-
-def parts_settings(budget: int, max_parts: int) -> PartsSettings:
-    """A part's search a tenth of the budget; all parts of a concept at most the budget."""
-    return PartsSettings(max_parts=max_parts, budget=max(1, budget // 10), allowance=budget)
 
 
 def learn_missed(concepts: Sequence[str], pairs: Callable[[str], Pairs],
