@@ -50,7 +50,10 @@ def parts_pass(run: Run, concepts: Sequence[str], pairs: Callable[[str, str], Pa
 
     it = settings.max_iterations
     found = run.found()
-    vocab, model = start or fit_model([parse(found[c]["program"]) for c in sorted(found)], settings,
+    # fitted on the iterations' programs only: a resumed pass searches with the model its
+    # first session wrote, not one that has also seen what the pass found
+    before = {c: r for c, r in found.items() if r["iteration"] < it}
+    vocab, model = start or fit_model([parse(before[c]["program"]) for c in sorted(before)], settings,
                                       settings.subroutines)
     write_model(run, it, settings, vocab, model)
     missed = [c for c in dict.fromkeys(concepts) if c not in found and c not in run.tried(it)]

@@ -64,9 +64,12 @@ def test_a_finished_run_resumed_with_parts_learns_what_it_missed(ds, tmp_path):
     assert (out / "model-1.json").exists()  # the model the pass searched with
     assert json.loads((out / "run.json").read_text())["settings"]["parts"] == 2
 
-    lines = len(read_records(out / "results.jsonl"))
+    lines, model = len(read_records(out / "results.jsonl")), (out / "model-1.json").read_text()
     _induce(ds, out, parts=2)  # resumed again: the pass is not repeated
     assert len(read_records(out / "results.jsonl")) == lines
+    # and its model is the one it searched with: fitted on the iterations' programs, not
+    # on what the pass itself found (a refit would add the two-part program)
+    assert (out / "model-1.json").read_text() == model
 
 
 def test_the_last_pass_searches_whole_first_with_the_model_of_what_was_found(ds, tmp_path):
