@@ -54,12 +54,17 @@ def allowed_values(pairs: Sequence[tuple[Scene, Scene]], tau: float = DEFAULT_CO
     return out
 
 
+def check_filters(filters: str) -> None:
+    """One line naming a filters mode that is not one (settings read from a file, or code)."""
+    if filters not in FILTER_MODES:
+        raise ValueError(f"--filters must be one of {', '.join(FILTER_MODES)}, got {filters!r}")
+
+
 def with_filters(probs: dict[str, np.ndarray], pairs: Sequence[tuple[Scene, Scene]], filters: str,
                  tau: float = DEFAULT_CONFIG.tau) -> dict[str, np.ndarray]:
     """The predictor's probabilities with the filter values the pairs rule out set to 0
     (`filters` 'acted'), or unchanged ('network')."""
-    if filters not in FILTER_MODES:
-        raise ValueError(f"--filters must be one of {', '.join(FILTER_MODES)}, got {filters!r}")
+    check_filters(filters)
     if filters == "network":
         return probs
     out = dict(probs)

@@ -8,6 +8,7 @@ import shlex
 import subprocess
 from pathlib import Path
 
+from argpred.acted import FILTER_MODES
 from vccjax import runtime
 
 DEFAULT_DATA = Path.home() / ".cache" / "vccjax" / "argpred-data"
@@ -233,7 +234,7 @@ def add_commands(sub) -> None:
                    help="fill_color's arguments: 'predicted' by the network (default: the weights' own figures) "
                         "or 'gained', the colours some object gains in the pairs (what `vcc induce` searches "
                         "with by default; argpred.gained)")
-    e.add_argument("--filters", choices=["network", "acted"], default="network",
+    e.add_argument("--filters", choices=FILTER_MODES, default="network",
                    help="the filters' arguments: the network's alone (default: the weights' own figures) or "
                         "'acted', less the values the objects acted on rule out (what `vcc induce` searches "
                         "with by default; argpred.acted)")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from argpred.acted import FILTER_MODES
 from vccjax import files, runtime
 from vccjax.world.concepts import concept_list
 
@@ -134,7 +135,7 @@ def add_commands(sub) -> None:
                    help="with --args predicted: fill_color's arguments are the colours some object gains in the "
                         "pairs (default; exact: only fill_color changes a colour), or 'predicted' by the network "
                         "as the filters (the paper's)")
-    p.add_argument("--filters", choices=["acted", "network"], default="acted",
+    p.add_argument("--filters", choices=FILTER_MODES, default="acted",
                    help="with --args predicted: drop the shape and colour filter values the objects acted on rule "
                         "out (default; where one pair changes three or more kinds of objects, only values of an "
                         "object left in place stay), or 'network': the network's filters alone (the paper's)")

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from argpred.acted import FILTER_MODES
+from argpred.acted import check_filters
 from argpred.gained import FILL_MODES
 from search.arguments import MODES as ARG_MODES
 from search.chain import Chain
@@ -72,8 +72,7 @@ class Settings:
             raise ValueError(f"--arg-threshold must be above 0 and at most 1, got {self.arg_threshold}")
         if self.fill not in FILL_MODES:
             raise ValueError(f"--fill must be one of {', '.join(FILL_MODES)}, got {self.fill!r}")
-        if self.filters not in FILTER_MODES:
-            raise ValueError(f"--filters must be one of {', '.join(FILTER_MODES)}, got {self.filters!r}")
+        check_filters(self.filters)
 
 
 def needs_answer(settings: Settings) -> bool:

@@ -20,6 +20,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from argpred.acted import check_filters
 from search.ambiguity import Verdict, fresh_scenes, judge, outcomes
 from search.arguments import argument_logp
 from search.chain import Chain
@@ -56,8 +57,7 @@ class LearnSettings:
     def __post_init__(self) -> None:
         if self.args not in ("predicted", "uniform"):
             raise ValueError(f"--args must be predicted or uniform, got {self.args!r}")
-        if self.filters not in ("acted", "network"):
-            raise ValueError(f"--filters must be acted or network, got {self.filters!r}")
+        check_filters(self.filters)
         if self.budget < 1:
             raise ValueError(f"--budget must be positive, got {self.budget}")
         if not 1 <= self.parts <= 5:

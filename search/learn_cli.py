@@ -14,6 +14,7 @@ import os
 import tempfile
 from pathlib import Path
 
+from argpred.acted import FILTER_MODES
 from vccjax import files as vfiles, runtime
 from vccjax.errors import DataFileError, ProgramSyntaxError, VCCError, read_json
 from vccjax.records import check_fields
@@ -249,7 +250,7 @@ def add_commands(sub) -> None:
                         "what a library's search misses is searched from scratch over a tenth of the budget")
     p.add_argument("--args", choices=["predicted", "uniform"], default="predicted",
                    help="arguments: predicted by the CNN from the pairs (default) or uniform")
-    p.add_argument("--filters", choices=["acted", "network"], default="acted",
+    p.add_argument("--filters", choices=FILTER_MODES, default="acted",
                    help="with --args predicted: drop the filter values the objects acted on rule out (default; "
                         "where one pair changes three or more kinds of objects, only the values of an object left "
                         "in place stay), or 'network': the network's filters alone, for a concept that acts on "

@@ -298,9 +298,10 @@ def remembering(firsts: Sequence[Program], chain: Chain, pairs: Sequence[tuple[S
     for first parts, which tells them apart by their scenes, never keeps it. In the
     first parts' order (most progress first), each one's variants cheapest first."""
     inputs = [a for a, _ in pairs]
+    own = [_memory(f, inputs, cfg) for f in firsts]
     found: list[tuple[int, float, int, Program, tuple]] = []
     for k, first in enumerate(firsts):
-        scenes = tuple(None if m is None else m[0] for m in _memory(first, inputs, cfg))
+        scenes = tuple(None if m is None else m[0] for m in own[k])
         for pos in range(1, len(first.ops) + 1):
             for name in REMEMBERING:
                 lp = chain.arg_logp.get(OP[name])
@@ -311,7 +312,7 @@ def remembering(firsts: Sequence[Program], chain: Chain, pairs: Sequence[tuple[S
                     memory = () if spelt is None else _memory(v, inputs, cfg)
                     if spelt is not None and tuple(None if m is None else m[0] for m in memory) == scenes:
                         found.append((k, float(spelt[0]), len(found), v, memory))
-    seen = {_memory(f, inputs, cfg) for f in firsts}  # a variant remembering nothing new is its first part
+    seen = set(own)  # a variant remembering nothing new is its first part
     out = []
     for *_, v, memory in sorted(found, key=lambda f: f[:3]):
         if memory not in seen:
