@@ -16,12 +16,22 @@ the objects acted on rule out").
 
 Unlike `argpred.gained`, this is not exact: a concept that acts on some objects through
 a filter and on several kinds with none ("the squares left, then every object up")
-loses the filter. Searches take it by default (`--filters acted`); `--filters network`
-searches with the network's filters alone.
+loses the filter.
+
+The pairs also point values in (`--filters acted+raised`, the default): where, over all
+pairs, the objects changed are of at most two colours (shapes), a filter on those kinds
+explains the pairs, and such a value the network gives at least `SUPPORT` is raised to
+the threshold ("all yellow left AND all green right" whose pairs the network reads as
+yellow alone); and a value beside which the moved objects end, in nearly every pair, is a
+landmark the program attends ("move the star to touch the circle"), raised too. The
+network alone misses these where the value's objects are few or never change. `--filters
+acted` only rules values out, `--filters network` takes the network's alone.
 """
 
 from __future__ import annotations
 
+import math
+from collections import Counter
 from collections.abc import Sequence
 
 import numpy as np
@@ -30,8 +40,12 @@ from vccjax.machine.config import DEFAULT_CONFIG
 from vccjax.machine.instructions import COLORS, SHAPES
 from vccjax.machine.scene import Scene, SceneObject
 
-FILTER_MODES = ("acted", "network")  # acted: this rule on top of the network; network: the network alone
+# acted+raised: values ruled out and pointed in; acted: ruled out only; network: the network alone
+FILTER_MODES = ("acted+raised", "acted", "network")
 SPAN = 3  # kinds of objects changed in one pair that no one or two filters of that attribute explain
+SUPPORT = 0.2  # the network's least probability for a value of the changed kinds to be raised
+LANDMARK_SHARE = 0.9  # share of the pairs with moved objects in which they end beside the value
+LANDMARK_PAIRS = 5  # fewer pairs with moved objects than this point to no landmark (chance)
 _FILTERS = {"set_shape_attn": ("shape", SHAPES), "set_color_attn": ("color", COLORS)}
 
 
@@ -54,6 +68,41 @@ def allowed_values(pairs: Sequence[tuple[Scene, Scene]], tau: float = DEFAULT_CO
     return out
 
 
+def changed_kinds(pairs: Sequence[tuple[Scene, Scene]], attr: str, tau: float = DEFAULT_CONFIG.tau) -> set[str]:
+    """The values of `attr` ('shape' or 'color') of the objects any pair changes."""
+    return {getattr(o, attr) for a, b in pairs for o in a.objects if not stays(o, b, tau)}
+
+
+def landmarks(pairs: Sequence[tuple[Scene, Scene]], attr: str, tau: float = DEFAULT_CONFIG.tau) -> set[str]:
+    """The values of `attr` of the object nearest to where every moved object ends (among
+    the objects left in place), in at least `LANDMARK_SHARE` of the pairs that move any;
+    none with fewer than `LANDMARK_PAIRS` such pairs."""
+    beside: list[set[str]] = []
+    for a, b in pairs:
+        moved = [o for o in b.objects if not stays(o, a, tau)]
+        still = [o for o in b.objects if stays(o, a, tau)]
+        if not moved:
+            continue
+        near = [getattr(min(still, key=lambda p: math.hypot(p.x - o.x, p.y - o.y)), attr) for o in moved] if still else []
+        beside.append(set(near) if len(set(near)) == 1 else set())
+    if len(beside) < LANDMARK_PAIRS:
+        return set()
+    counts = Counter(v for values in beside for v in values)
+    return {v for v, k in counts.items() if k >= LANDMARK_SHARE * len(beside)}
+
+
+def raised_values(probs: dict[str, np.ndarray], pairs: Sequence[tuple[Scene, Scene]],
+                  tau: float = DEFAULT_CONFIG.tau) -> dict[str, set[str]]:
+    """Per filter instruction, the values the pairs point in (see the module's docstring)."""
+    out: dict[str, set[str]] = {}
+    for name, (attr, domain) in _FILTERS.items():
+        kinds = changed_kinds(pairs, attr, tau)
+        p = dict(zip(domain, np.asarray(probs.get(name, np.zeros(len(domain))), np.float64)))
+        confined = {v for v in kinds if p[v] >= SUPPORT} if len(kinds) < SPAN else set()
+        out[name] = confined | landmarks(pairs, attr, tau)
+    return out
+
+
 def check_filters(filters: str) -> None:
     """One line naming a filters mode that is not one (settings read from a file, or code)."""
     if filters not in FILTER_MODES:
@@ -61,9 +110,10 @@ def check_filters(filters: str) -> None:
 
 
 def with_filters(probs: dict[str, np.ndarray], pairs: Sequence[tuple[Scene, Scene]], filters: str,
-                 tau: float = DEFAULT_CONFIG.tau) -> dict[str, np.ndarray]:
+                 tau: float = DEFAULT_CONFIG.tau, threshold: float = 0.55) -> dict[str, np.ndarray]:
     """The predictor's probabilities with the filter values the pairs rule out set to 0
-    (`filters` 'acted'), or unchanged ('network')."""
+    (`filters` 'acted'), those they point in then raised to at least `threshold`
+    ('acted+raised'), or unchanged ('network')."""
     check_filters(filters)
     if filters == "network":
         return probs
@@ -72,4 +122,10 @@ def with_filters(probs: dict[str, np.ndarray], pairs: Sequence[tuple[Scene, Scen
         if values is not None and name in out:
             domain = _FILTERS[name][1]
             out[name] = np.where([v in values for v in domain], np.asarray(out[name], np.float64), 0.0)
+    if filters == "acted+raised":
+        for name, values in raised_values(out, pairs, tau).items():
+            if values and name in out:
+                domain = _FILTERS[name][1]
+                p = np.asarray(out[name], np.float64)
+                out[name] = np.where([v in values for v in domain], np.maximum(p, threshold), p)
     return out

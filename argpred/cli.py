@@ -236,8 +236,9 @@ def add_commands(sub) -> None:
                         "with by default; argpred.gained)")
     e.add_argument("--filters", choices=FILTER_MODES, default="network",
                    help="the filters' arguments: the network's alone (default: the weights' own figures) or "
-                        "'acted', less the values the objects acted on rule out (what `vcc induce` searches "
-                        "with by default; argpred.acted)")
+                        "'acted', less the values the objects acted on rule out, or 'acted+raised', also with "
+                        "the values the pairs point in raised (what `vcc induce` searches with by default; "
+                        "argpred.acted)")
     e.add_argument("--out", "--json", dest="out", type=runtime.out_file(".json"),
                    help="write the result JSON here: recall, concepts recalled, misses, mean extra arguments "
                         "per function, the weights' sha256, date, commit and command")

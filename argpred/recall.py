@@ -33,14 +33,15 @@ def recall(predictor: Predictor, concepts: Sequence[str],
            fill: str = "predicted", filters: str = "network") -> dict:
     """Recall and extra arguments; `fill` 'gained' takes fill_color's from the pairs
     (`argpred.gained`), `filters` 'acted' drops the filter values the objects acted on rule
-    out (`argpred.acted`), as the search does by default."""
+    out, 'acted+raised' also raises those the pairs point in (`argpred.acted`), as the
+    search does by default."""
     missed: dict[str, dict[str, list[str]]] = {}
     extra = {f: [] for f in PREDICTED}
     extras: dict[str, dict[str, list[str]]] = {}  # per concept, the arguments passed that it never uses
     unused, kept = dict.fromkeys(PREDICTED, 0), dict.fromkeys(PREDICTED, 0)
     for c in concepts:
-        ok = passing(with_filters(with_fill(predictor.for_pairs(pairs(c)), pairs(c), fill), pairs(c), filters),
-                     threshold)
+        ok = passing(with_filters(with_fill(predictor.for_pairs(pairs(c)), pairs(c), fill), pairs(c), filters,
+                                  threshold=threshold), threshold)
         used = used_arguments(c)
         miss = {f: sorted(used[f] - set(ok[f])) for f in PREDICTED if used[f] - set(ok[f])}
         if miss:

@@ -7,8 +7,9 @@ Modes (`vcc induce --args`, `vcc learn`):
   pairs (arguments under 0.55 dropped, an instruction with none left out;
   `argpred.predict`); `fill_color` the colours some object gains in the pairs
   (`argpred.gained`; `fill="predicted"`: from the CNN as the filters); the filters'
-  values the objects acted on rule out dropped (`argpred.acted`; `filters="network"`:
-  the CNN's alone); `fixate` and `imagine_object` uniform;
+  values the objects acted on rule out dropped, those the changed objects' kinds or a
+  landmark point in raised (`argpred.acted`; `filters="acted"`: dropped only,
+  `filters="network"`: the CNN's alone); `fixate` and `imagine_object` uniform;
 - oracle: uniform over the values an answer program uses, an instruction with arguments
   it never uses left out (what a perfect predictor gives; a research setting that reads
   the answer, never a default);
@@ -48,12 +49,12 @@ def used_values(program: Program, name: str) -> list[int]:
 def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None, answer: Program | None = None,
                   fixate: Sequence[str] | None = None, fallback: bool = False,
                   threshold: float | None = None, fill: str = "gained",
-                  filters: str = "acted") -> dict[int, np.ndarray]:
+                  filters: str = "acted+raised") -> dict[int, np.ndarray]:
     """log p(argument | instruction) under `mode` (see the module's docstring). `answer`
     is needed by oracle and, without `fixate`, by +fixation; `pairs` by predicted, which
     keeps the arguments at or above `threshold` (default the paper's 0.55) and takes
     `fill_color`'s as `fill` says ('gained' or 'predicted'), the filters' as `filters`
-    says ('acted' or 'network'). With `fallback`, a predicted function none of whose
+    says ('acted+raised', 'acted' or 'network'). With `fallback`, a predicted function none of whose
     arguments pass keeps the network's probabilities instead of being left out; a
     function the pairs' rules leave no value (fill_color read from the pairs is exact)
     has none to fall back on."""
@@ -72,8 +73,10 @@ def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
         from argpred.acted import with_filters
         from argpred.gained import with_fill
 
-        probs = with_filters(with_fill(default_predictor().for_pairs(pairs), pairs, fill), pairs, filters)
-        for name, lp in predicted(probs, THRESHOLD if threshold is None else threshold).items():
+        threshold = THRESHOLD if threshold is None else threshold
+        probs = with_filters(with_fill(default_predictor().for_pairs(pairs), pairs, fill), pairs, filters,
+                             threshold=threshold)
+        for name, lp in predicted(probs, threshold).items():
             exact = name == "fill_color" and fill == "gained"
             p = np.asarray(probs[name], np.float64)
             if fallback and not exact and not np.isfinite(lp).any() and p.sum() > 0:

@@ -135,10 +135,12 @@ def add_commands(sub) -> None:
                    help="with --args predicted: fill_color's arguments are the colours some object gains in the "
                         "pairs (default; exact: only fill_color changes a colour), or 'predicted' by the network "
                         "as the filters (the paper's)")
-    p.add_argument("--filters", choices=FILTER_MODES, default="acted",
+    p.add_argument("--filters", choices=FILTER_MODES, default="acted+raised",
                    help="with --args predicted: drop the shape and colour filter values the objects acted on rule "
-                        "out (default; where one pair changes three or more kinds of objects, only values of an "
-                        "object left in place stay), or 'network': the network's filters alone (the paper's)")
+                        "out (where one pair changes three or more kinds of objects, only values of an object left "
+                        "in place stay) and raise to the threshold those the pairs point in (the kinds of the "
+                        "changed objects where they are at most two, a landmark the moved objects end beside) "
+                        "(default); 'acted': drop only; 'network': the network's filters alone (the paper's)")
     p.add_argument("--parts", type=runtime.count(1, 3), default=1,
                    help="2 or 3: after the iterations, a last pass over the concepts still missed, each "
                         "searched whole with the model of everything found and, where that fails, in up to "

@@ -57,7 +57,7 @@ class Settings:
     parts: int = 1  # >= 2: a last pass over missed concepts, whole then in up to this many parts (1: none)
     arg_threshold: float = 0.55  # predicted arguments pass at this probability (the paper's 0.55)
     fill: str = "gained"  # predicted modes: fill_color's arguments from the colours objects gain, or "predicted"
-    filters: str = "acted"  # predicted modes: filter values the objects acted on rule out dropped, or "network"
+    filters: str = "acted+raised"  # predicted: filter values the pairs rule out dropped, point in raised
 
     def __post_init__(self) -> None:
         if self.args not in ARG_MODES:

@@ -41,7 +41,7 @@ LIBRARIES = ("shipped", "uniform")  # or a library file's path
 class LearnSettings:
     budget: int = 500_000  # programs searched for the first fit, at most
     args: str = "predicted"  # or "uniform"
-    filters: str = "acted"  # predicted: filter values the objects acted on rule out dropped, or "network"
+    filters: str = "acted+raised"  # predicted: filter values the pairs rule out dropped, point in raised
     fixate: tuple[str, ...] | None = None  # the teacher's hint: fixate only to these
     library: str = "shipped"  # "shipped", "uniform" (from scratch) or a library file
     rival_margin_nats: float = 6.0  # rivals at most this much less probable than the first

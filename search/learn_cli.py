@@ -250,11 +250,13 @@ def add_commands(sub) -> None:
                         "what a library's search misses is searched from scratch over a tenth of the budget")
     p.add_argument("--args", choices=["predicted", "uniform"], default="predicted",
                    help="arguments: predicted by the CNN from the pairs (default) or uniform")
-    p.add_argument("--filters", choices=FILTER_MODES, default="acted",
-                   help="with --args predicted: drop the filter values the objects acted on rule out (default; "
-                        "where one pair changes three or more kinds of objects, only the values of an object left "
-                        "in place stay), or 'network': the network's filters alone, for a concept that acts on "
-                        "some objects through a filter and on many kinds with none")
+    p.add_argument("--filters", choices=FILTER_MODES, default="acted+raised",
+                   help="with --args predicted: drop the filter values the objects acted on rule out (where one "
+                        "pair changes three or more kinds of objects, only the values of an object left in place "
+                        "stay) and raise those the pairs point in (the changed objects' kinds where at most two, "
+                        "a landmark the moved objects end beside) (default); 'acted': drop only; 'network': the "
+                        "network's filters alone, for a concept that acts on some objects through a filter and "
+                        "on many kinds with none")
     p.add_argument("--fixate", help="the teacher's hint: where to look first (left, right, top, bottom, center; "
                                     "several comma-separated)")
     p.add_argument("--rival-budget", type=runtime.count(0, 10**10), default=2_000_000,

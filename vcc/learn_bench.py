@@ -38,9 +38,10 @@ STARTS = ("library", "uniform")
 # graded first parts continued from the machine state they leave (`search.parts.continued`);
 # 6: fill_color's arguments from the colours objects gain (`argpred.gained`), not the network;
 # 7: filter values the objects acted on rule out dropped (`argpred.acted`); 8: first parts
-# continued once more with a fixation added (`search.parts.remembering`)
+# continued once more with a fixation added (`search.parts.remembering`); 9: filter values
+# the pairs point in raised (`argpred.acted`, `--filters acted+raised`)
 # (a run of another protocol is refused)
-PROTOCOL = 8
+PROTOCOL = 9
 # What every results line must hold (the key of `_key`, and whether it was found).
 RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 

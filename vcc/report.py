@@ -101,7 +101,9 @@ def _predicted(settings: dict) -> str:
     t = settings.get("arg_threshold", 0.55)
     return ((f", threshold {t:g}" if t != 0.55 else "")
             + (", fill_color from the colours objects gain" if settings.get("fill") == "gained" else "")
-            + (", filters the objects acted on rule out dropped" if settings.get("filters") == "acted" else ""))
+            + {"acted": ", filters the objects acted on rule out dropped",
+               "acted+raised": ", filters the objects acted on rule out dropped, those the pairs point in raised"}
+            .get(settings.get("filters"), ""))
 
 
 def _weights(s: dict | None) -> str:
@@ -334,7 +336,9 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
         if len(d["missed"]) > len(shown):
             missed += f"; and {len(d['missed']) - len(shown)} more (in the file)"
         fill = "the gained colours" if d.get("fill") == "gained" else "the network"  # files before `fill`: the network
-        filters = "less those the objects acted on rule out" if d.get("filters") == "acted" else "the network"
+        filters = {"acted": "less those the objects acted on rule out",
+                   "acted+raised": "less those the objects acted on rule out, those the pairs point in raised"
+                   }.get(d.get("filters"), "the network")
         lines.append(f"| `{name}` | {d['weights']} `{d['weights_sha256'][:8]}` ({d['members']} networks) | {fill} | "
                      f"{filters} | "
                      f"{n} ({d['split']}) | {d.get('threshold', 0.55):g} | {d['recalled']} ({d['recall']:.1%}) | {extra} | "
