@@ -213,6 +213,10 @@ def cmd_bench_reproduce(a: argparse.Namespace) -> int:
         for k, row in enumerate(rows):
             out = rp.folder(runs, row, tag, a.scale)
             print(f"[{k + 1}/{len(rows)}] {row.name}: {row.what} -> {out}", flush=True)
+            if rp.finished_otherwise(out, rp.scaled(row, a.scale)) is not None:
+                print(f"  kept: {out} holds this row finished under settings since changed (its run.json says "
+                      "which; the report gives them); move the folder aside to run it with today's")
+                continue
             try:
                 s = rp.run_row(row, names, out, a.scale, a.dataset, a.width, not a.quiet, searcher)
             except KeyboardInterrupt:

@@ -123,6 +123,18 @@ def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset:
     return s
 
 
+def finished_otherwise(out: Path, settings: Settings) -> dict | None:
+    """The recorded settings of a row folder whose run finished under settings that search
+    otherwise than `settings` (a default changed since), else None: such a row is kept as
+    it is and reported with its own settings; to rerun it, move the folder aside."""
+    from search.induce import Run, same_search
+
+    if not ((out / "run.json").exists() and (out / "summary.json").exists()):
+        return None
+    recorded = Run.view(out)._meta()["settings"]  # checked: a foreign run.json is one line
+    return None if same_search(recorded, dataclasses.asdict(settings)) else recorded
+
+
 def read_row(path: Path) -> dict | None:
     """A row folder's figures: its summary when the run finished, else what its records say
     so far (marked partial). None when the folder holds no run."""

@@ -92,6 +92,17 @@ def test_bench_reproduce_runs_rows_resumes_and_reports_the_rest_as_not_run(tmp_p
     lines = (main_row / "results.jsonl").read_text()
     assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M")) == 0
     assert (main_row / "results.jsonl").read_text() == lines
+    # a row finished under a default since changed is kept as it is (and reported), not refused
+    meta = json.loads((main_row / "run.json").read_text())
+    meta["settings"]["filters"] = "network"
+    (main_row / "run.json").write_text(json.dumps(meta))
+    capsys.readouterr()
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M")) == 0
+    assert "kept: " in capsys.readouterr().out and (main_row / "results.jsonl").read_text() == lines
+    # unfinished, it is refused in one line: resuming would mix two settings in one run
+    (main_row / "summary.json").unlink()
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M")) != 0
+    assert "other settings" in capsys.readouterr().err and (main_row / "results.jsonl").read_text() == lines
 
 
 def _emulator_result(date: str, commit: str, ratio: float, per_instruction: dict, k: int) -> dict:
