@@ -83,7 +83,8 @@ def landmarks(pairs: Sequence[tuple[Scene, Scene]], attr: str, tau: float = DEFA
         still = [o for o in b.objects if stays(o, a, tau)]
         if not moved:
             continue
-        near = [getattr(min(still, key=lambda p: math.hypot(p.x - o.x, p.y - o.y)), attr) for o in moved] if still else []
+        near = [getattr(min(still, key=lambda p: math.hypot(p.x - o.x, p.y - o.y)), attr)
+                for o in moved] if still else []
         beside.append(set(near) if len(set(near)) == 1 else set())
     if len(beside) < LANDMARK_PAIRS:
         return set()
@@ -98,7 +99,7 @@ def raised_values(probs: dict[str, np.ndarray], pairs: Sequence[tuple[Scene, Sce
     for name, (attr, domain) in _FILTERS.items():
         kinds = changed_kinds(pairs, attr, tau)
         p = dict(zip(domain, np.asarray(probs.get(name, np.zeros(len(domain))), np.float64)))
-        confined = {v for v in kinds if p[v] >= SUPPORT} if len(kinds) < SPAN else set()
+        confined = {v for v in kinds if p.get(v, 0.0) >= SUPPORT} if len(kinds) < SPAN else set()
         out[name] = confined | landmarks(pairs, attr, tau)
     return out
 
@@ -113,7 +114,8 @@ def with_filters(probs: dict[str, np.ndarray], pairs: Sequence[tuple[Scene, Scen
                  tau: float = DEFAULT_CONFIG.tau, threshold: float = 0.55) -> dict[str, np.ndarray]:
     """The predictor's probabilities with the filter values the pairs rule out set to 0
     (`filters` 'acted'), those they point in then raised to at least `threshold`
-    ('acted+raised'), or unchanged ('network')."""
+    (the search's, `argpred.predict.THRESHOLD` by default; 'acted+raised'), or unchanged
+    ('network')."""
     check_filters(filters)
     if filters == "network":
         return probs
