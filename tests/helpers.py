@@ -49,3 +49,14 @@ def run_both(program: Program | str, sc: Scene, cfg: VCCConfig = DEFAULT_CONFIG)
         assert scenes_match(output_scene(c, st, cfg), ref.output_scene(), 1e-9), program
     return ref, st
 
+
+
+def reference_pairs(program: str, scenes: list[Scene]) -> list[tuple[Scene, Scene]]:
+    """(input, output) of the reference machine running `program` on each scene; a failing
+    run is no example."""
+    p, out = parse(program), []
+    for s in scenes:
+        m = RefMachine(s).run(p)
+        if not m.failed:
+            out.append((s, m.output_scene()))
+    return out

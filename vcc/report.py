@@ -10,6 +10,7 @@ from vcc import reproduce as rp
 from vccjax import files
 from vccjax.errors import DataFileError
 
+RULED, RAISED = "the objects acted on rule out", ", those the pairs point in raised"  # `--filters` said
 TARGETS = {"emulator": 20.0, "search": 25_000, "main_wall_s": 2 * 3600, "main_found": 526, "stretch": 540}
 
 
@@ -101,9 +102,8 @@ def _predicted(settings: dict) -> str:
     t = settings.get("arg_threshold", 0.55)
     return ((f", threshold {t:g}" if t != 0.55 else "")
             + (", fill_color from the colours objects gain" if settings.get("fill") == "gained" else "")
-            + {"acted": ", filters the objects acted on rule out dropped",
-               "acted+raised": ", filters the objects acted on rule out dropped, those the pairs point in raised"}
-            .get(settings.get("filters"), ""))
+            + (f", filters {RULED} dropped" if str(settings.get("filters")).startswith("acted") else "")
+            + (RAISED if settings.get("filters") == "acted+raised" else ""))
 
 
 def _weights(s: dict | None) -> str:
@@ -336,9 +336,8 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
         if len(d["missed"]) > len(shown):
             missed += f"; and {len(d['missed']) - len(shown)} more (in the file)"
         fill = "the gained colours" if d.get("fill") == "gained" else "the network"  # files before `fill`: the network
-        filters = {"acted": "less those the objects acted on rule out",
-                   "acted+raised": "less those the objects acted on rule out, those the pairs point in raised"
-                   }.get(d.get("filters"), "the network")
+        filters = (f"less those {RULED}" + (RAISED if d.get("filters") == "acted+raised" else "")
+                   if str(d.get("filters")).startswith("acted") else "the network")
         lines.append(f"| `{name}` | {d['weights']} `{d['weights_sha256'][:8]}` ({d['members']} networks) | {fill} | "
                      f"{filters} | "
                      f"{n} ({d['split']}) | {d.get('threshold', 0.55):g} | {d['recalled']} ({d['recall']:.1%}) | {extra} | "

@@ -9,10 +9,9 @@ import numpy as np
 import pytest
 
 from argpred.acted import SPAN, allowed_values, stays, with_filters
+from tests.helpers import reference_pairs
 from search.arguments import argument_logp, used_values
 from vccjax.machine.instructions import COLORS, OP, SHAPES
-from vccjax.machine.program import parse
-from vccjax.machine.reference import RefMachine
 from vccjax.machine.scene import Scene, SceneObject
 
 SQ, CI, TR, ST = "square", "circle", "triangle", "star"
@@ -20,16 +19,6 @@ SQ, CI, TR, ST = "square", "circle", "triangle", "star"
 
 def _scene(*objs: tuple[str, str, float, float]) -> Scene:
     return Scene(tuple(SceneObject(s, c, x, y, 0.08) for s, c, x, y in objs))
-
-
-def _pairs(program: str, scenes: list[Scene]) -> list[tuple[Scene, Scene]]:
-    """(input, output) for the scenes the program runs on (a failing run is no example)."""
-    p, out = parse(program), []
-    for s in scenes:
-        m = RefMachine(s).run(p)
-        if not m.failed:
-            out.append((s, m.output_scene()))
-    return out
 
 
 SCENES = [
@@ -80,7 +69,7 @@ def test_programs_through_one_filter_keep_its_value_on_the_reference_machine(att
             scenes = [s for s in SCENES if any(getattr(o, attr) == v for o in s.objects)]
             if not scenes:
                 continue
-            pairs = _pairs(text, scenes)
+            pairs = reference_pairs(text, scenes)
             if not pairs:
                 continue
             got = allowed_values(pairs)[instruction]
@@ -91,7 +80,8 @@ def test_programs_through_one_filter_keep_its_value_on_the_reference_machine(att
     for v, w in itertools.combinations(values, 2):
         loop = "loop_start; top_down_attend; move_hand_to_attended_object; grab_object; move_hand_up; " \
                "release_object; next_object; loop_end"
-        pairs = _pairs(f"scene_parse; {instruction}({v}); {loop}; reset_attn; {instruction}({w}); {loop}", SCENES)
+        text = f"scene_parse; {instruction}({v}); {loop}; reset_attn; {instruction}({w}); {loop}"
+        pairs = reference_pairs(text, SCENES)
         got = allowed_values(pairs)[instruction]
         assert pairs and (got is None or {v, w} <= got), (v, w)
 

@@ -9,10 +9,9 @@ import pytest
 
 from argpred.acted import (LANDMARK_PAIRS, SUPPORT, changed_kinds, landmarks, raised_values, stays,
                            with_filters)
+from tests.helpers import reference_pairs
 from search.arguments import argument_logp, used_values
 from vccjax.machine.instructions import COLORS, OP, SHAPES
-from vccjax.machine.program import parse
-from vccjax.machine.reference import RefMachine
 from vccjax.machine.scene import Scene, SceneObject
 
 MOVE = "move_hand_to_attended_object; grab_object; {move}; release_object"
@@ -41,15 +40,6 @@ def _scenes(n: int, seed: int, must: tuple[tuple[str, str | None], ...] = (), sh
     return out
 
 
-def _pairs(program: str, scenes: list[Scene]) -> list[tuple[Scene, Scene]]:
-    p, out = parse(program), []
-    for s in scenes:
-        m = RefMachine(s).run(p)
-        if not m.failed:
-            out.append((s, m.output_scene()))
-    return out
-
-
 def _probs(shape: dict[str, float], color: dict[str, float]) -> dict[str, np.ndarray]:
     return {"set_shape_attn": np.array([shape.get(v, 0.0) for v in SHAPES]),
             "set_color_attn": np.array([color.get(v, 0.0) for v in COLORS])}
@@ -59,7 +49,7 @@ def test_two_filtered_kinds_changed_raise_the_weak_one_the_network_supports():
     """"All yellow left AND all green right": only yellow and green objects change, so a
     green the network reads at 0.3 is raised to the threshold; a colour no changed object
     has, or one under `SUPPORT`, is not."""
-    pairs = _pairs(TWO_KINDS, _scenes(6, 0, (("square", "yellow"), ("circle", "green"))))
+    pairs = reference_pairs(TWO_KINDS, _scenes(6, 0, (("square", "yellow"), ("circle", "green"))))
     assert len(pairs) >= 5
     kinds = changed_kinds(pairs, "color")
     assert kinds == {"yellow", "green"}  # both kinds move in some pair (each scene holds one of each)
@@ -75,7 +65,7 @@ def test_two_filtered_kinds_changed_raise_the_weak_one_the_network_supports():
 
 def test_many_kinds_changed_point_to_no_filter():
     """Every object moves up: the changed objects span the colours, no value is raised."""
-    pairs = _pairs("scene_parse; loop_start; top_down_attend; " + MOVE.format(move="move_hand_up")
+    pairs = reference_pairs("scene_parse; loop_start; top_down_attend; " + MOVE.format(move="move_hand_up")
                    + "; next_object; loop_end", _scenes(6, 1))
     assert len(changed_kinds(pairs, "color")) >= 3
     assert raised_values(_probs({v: 0.5 for v in SHAPES}, {v: 0.5 for v in COLORS}), pairs) == \
@@ -84,9 +74,10 @@ def test_many_kinds_changed_point_to_no_filter():
 
 def test_a_landmark_the_moved_object_ends_beside_is_raised_from_enough_pairs():
     """"Move the star to touch the circle": the circle (of any colour) is nearest to where
-    the star ends in every pair (one other object in each scene), so circle is raised however low the network reads it; no
-    colour is, and fewer than `LANDMARK_PAIRS` pairs point to none."""
-    pairs = _pairs(TOUCH, _scenes(8, 2, (("star", "red"), ("circle", None)), ("square", "triangle", "diamond"),
+    the star ends in every pair (one other object in each scene), so circle is raised
+    however low the network reads it; no colour is, and fewer than `LANDMARK_PAIRS` pairs
+    point to none."""
+    pairs = reference_pairs(TOUCH, _scenes(8, 2, (("star", "red"), ("circle", None)), ("square", "triangle", "diamond"),
                                   (3, 3)))
     assert len(pairs) >= LANDMARK_PAIRS
     for a, b in pairs:  # the star moved, the circle stayed
@@ -96,13 +87,14 @@ def test_a_landmark_the_moved_object_ends_beside_is_raised_from_enough_pairs():
     assert landmarks(pairs[:LANDMARK_PAIRS - 1], "shape") == set()
     got = with_filters(_probs({"star": 0.9, "circle": 0.05}, {}), pairs, "acted+raised")
     assert dict(zip(SHAPES, got["set_shape_attn"]))["circle"] == 0.55
-    assert dict(zip(SHAPES, with_filters(_probs({"circle": 0.05}, {}), pairs, "acted")["set_shape_attn"]))["circle"] == 0.05
+    acted = with_filters(_probs({"circle": 0.05}, {}), pairs, "acted")["set_shape_attn"]
+    assert dict(zip(SHAPES, acted))["circle"] == 0.05
 
 
 def test_the_search_takes_raised_values_by_default():
     from argpred.predict import THRESHOLD, default_predictor
 
-    pairs = _pairs(TWO_KINDS, _scenes(10, 3, (("square", "yellow"), ("circle", "green"))))
+    pairs = reference_pairs(TWO_KINDS, _scenes(10, 3, (("square", "yellow"), ("circle", "green"))))
     network = dict(zip(COLORS, default_predictor().for_pairs(pairs)["set_color_attn"]))
     lp = dict(zip(COLORS, argument_logp("predicted", pairs)[OP["set_color_attn"]]))
     for v in ("yellow", "green"):

@@ -295,6 +295,9 @@ def test_the_report_gives_the_predictors_recall_and_extra_arguments():
     acted = next(x for x in argpred_section([("a.json", {**d, "fill": "gained", "filters": "acted"})])
                  if x.startswith("| `a.json`"))
     assert "| the gained colours | less those the objects acted on rule out | 8 (train) |" in acted
+    raised = next(x for x in argpred_section([("r.json", {**d, "fill": "gained", "filters": "acted+raised"})])
+                  if x.startswith("| `r.json`"))
+    assert "| less those the objects acted on rule out, those the pairs point in raised | 8 (train) |" in raised
     many = {**d, "missed": {f"c{k}": {"fill_color": ["red"]} for k in range(11)}}
     long_row = next(x for x in argpred_section([("m.json", many)]) if x.startswith("| `m.json`"))
     assert "c7: fill_color(red)" in long_row and "c8:" not in long_row and "and 3 more (in the file)" in long_row
@@ -318,6 +321,8 @@ def test_a_row_says_how_its_predicted_arguments_were_taken():
     both = _predicted({"args": "predicted", "arg_threshold": 0.6, "fill": "gained", "filters": "acted"})
     assert both == (", threshold 0.6, fill_color from the colours objects gain, "
                     "filters the objects acted on rule out dropped")
+    assert _predicted({"args": "predicted", "fill": "gained", "filters": "acted+raised"}).endswith(
+        "filters the objects acted on rule out dropped, those the pairs point in raised")
 
 
 def test_bench_emulator_cuts_batches_as_the_search_does():
