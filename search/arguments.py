@@ -54,8 +54,8 @@ def argument_logp(mode: str, pairs: Sequence[tuple[Scene, Scene]] | None = None,
     is needed by oracle and, without `fixate`, by +fixation; `pairs` by predicted, which
     keeps the arguments at or above `threshold` (default the paper's 0.55) and takes
     `fill_color`'s as `fill` says ('gained' or 'predicted'), the filters' as `filters`
-    says ('acted+raised', 'acted' or 'network'). With `fallback`, a predicted function none of whose
-    arguments pass keeps the network's probabilities instead of being left out; a
+    says ('acted+raised', 'acted' or 'network'). With `fallback`, a predicted function
+    none of whose arguments pass keeps the network's probabilities instead of being left out; a
     function the pairs' rules leave no value (fill_color read from the pairs is exact)
     has none to fall back on."""
     if mode not in MODES:
