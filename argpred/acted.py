@@ -79,8 +79,9 @@ def landmarks(pairs: Sequence[tuple[Scene, Scene]], attr: str, tau: float = DEFA
     none with fewer than `LANDMARK_PAIRS` such pairs."""
     beside: list[set[str]] = []
     for a, b in pairs:
-        moved = [o for o in b.objects if not stays(o, a, tau)]
-        still = [o for o in b.objects if stays(o, a, tau)]
+        left = [stays(o, a, tau) for o in b.objects]  # each output object: at its input place
+        moved = [o for o, k in zip(b.objects, left) if not k]
+        still = [o for o, k in zip(b.objects, left) if k]
         if not moved:
             continue
         near = [getattr(min(still, key=lambda p: math.hypot(p.x - o.x, p.y - o.y)), attr)
