@@ -144,7 +144,7 @@ def add_commands(sub) -> None:
     p.add_argument("--parts", type=runtime.count(1, 3), default=1,
                    help="2 or 3: after the iterations, a last pass over the concepts still missed, each "
                         "searched whole with the model of everything found and, where that fails, in up to "
-                        "this many parts (each part a tenth of the budget, all at most 1.1 budgets; "
+                        "this many parts (each part a tenth of the budget, all at most 1.3 budgets; "
                         "docs/search.md); 1 (default): no such pass. A finished run resumed with --parts 2 "
                         "or 3 adds it")
     p.add_argument("--dataset", help="a built dataset folder (default: the one shipped with vccjax, seed 0)")

@@ -239,7 +239,7 @@ def in_parts(searched: Result, pairs: Sequence[tuple[Scene, Scene]], settings: L
              log: Callable[[str], None] | None = None) -> tuple[Result, tuple[Program, ...]]:
     """`searched` (a search that found nothing) completed in parts when it can be
     (`search.parts`: each part's search covers a tenth of the budget, all of them together
-    at most 1.1 budgets), with the parts. The program's description length and rank
+    at most 1.3 budgets), with the parts. The program's description length and rank
     are those of its cheapest spelling under the chain of the whole pairs (or, where that
     chain rules out an argument a part uses, under the same model with uniform arguments).
     With a rival budget, the other joins that fit every pair come back as the result's

@@ -37,7 +37,7 @@ then the first part with `fixate_attended_object` before the move, and five toke
 The first parts are judged on the host by the scalar reference (`ScalarBackend` with
 another judge); the rest is an ordinary search on the caller's searcher. Each search
 covers a tenth of `vcc learn`'s budget (a remembering variant's a tenth of that), and
-all of them together at most 1.1 budgets (`parts_settings`), so parts cost about as much
+all of them together at most 1.3 budgets (`parts_settings`), so parts cost about as much
 as the plain search they follow.
 """
 
@@ -75,13 +75,15 @@ class PartsSettings:
     rivals: int = 0  # other fitting joins to keep, for the question back (0: stop at the first fit)
     continuations: bool = True  # when no join fits, search on from graded first parts' machine states
     remembering: int = 8  # then first parts with a fixation added (`remembering`), each searched on a tenth of `budget`
+    further: int = 2  # searches for a first part of more progress than any kept (`first_parts`)
 
 
 def parts_settings(budget: int, max_parts: int, rivals: int = 0) -> PartsSettings:
-    """A part's search a tenth of the budget; all parts of a concept at most 1.1 budgets:
-    the budget, and one part's more for the remembering variants."""
+    """A part's search a tenth of the budget; all parts of a concept at most 1.3 budgets:
+    the budget, one part's more for the remembering variants, and one for each of the
+    two searches for a first part of more progress (first parts, then graded ones)."""
     part = max(1, budget // 10)
-    return PartsSettings(max_parts=max_parts, budget=part, allowance=budget + part, rivals=rivals)
+    return PartsSettings(max_parts=max_parts, budget=part, allowance=budget + 3 * part, rivals=rivals)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -100,12 +102,14 @@ class ProgressBackend(ScalarBackend):
     example closer: where the first part's change is already made, as a top object
     already red, it rightly does nothing.)"""
 
-    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, graded: bool = False):
+    def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, graded: bool = False, above: int = 0):
         super().__init__(cfg)
         self.graded = graded
+        self.above = above  # accept only more progress than this (`gains` summed)
 
     def solves(self, machines: list[RefMachine], task: Task) -> bool:
-        return gains([m.output_scene() for m in machines], task.pairs, self.cfg.tau, self.graded) is not None
+        made = gains([m.output_scene() for m in machines], task.pairs, self.cfg.tau, self.graded)
+        return made is not None and sum(made) > self.above
 
 
 def graded_distance(a: Scene, b: Scene, tau: float) -> int:
@@ -139,25 +143,47 @@ def progress(program: Program, pairs: Sequence[tuple[Scene, Scene]], cfg: VCCCon
 
 
 def first_parts(chain: Chain, pairs: Sequence[tuple[Scene, Scene]], settings: PartsSettings,
-                cfg: VCCConfig = DEFAULT_CONFIG, graded: bool = False) -> tuple[list[Program], int]:
+                cfg: VCCConfig = DEFAULT_CONFIG, graded: bool = False,
+                allowance: _Allowance | None = None) -> tuple[list[Program], int]:
     """(first parts, most progress first then most probable; complete programs judged):
     programs that bring the pairs closer to their outputs (`ProgressBackend`), one per
-    distinct effect on the pairs (two that make the same scenes leave the same rest)."""
+    distinct effect on the pairs (two that make the same scenes leave the same rest).
+
+    The search keeps the `candidates` most probable within `margin_nats` of the
+    cheapest; the first part of most progress can lie past them ("take it down, then
+    left" where the model has rarely seen down followed by left). Then up to `further`
+    searches look for the most probable first part of more progress than any kept, each
+    within the part's budget and charged to `allowance` for the programs it covered."""
     inputs = [a for a, _ in pairs]
 
     def effect(path) -> tuple:
         made = outcomes(program_of(chain, [int(x) for x in path if x >= 0]), inputs, cfg)
         return tuple((None if m is None else (m.objects, m.pointer)) for m in made)
 
+    task = Task.from_pairs(pairs, cfg)
     searcher = Searcher(ProgressBackend(cfg, graded), width=1)
     alternatives = Alternatives(int(math.ceil(settings.margin_nats / chain.delta)), settings.candidates,
                                 settings.budget, effect)
-    r = searcher.search(chain, Task.from_pairs(pairs, cfg), settings.budget, alternatives=alternatives)
+    r = searcher.search(chain, task, settings.budget, alternatives=alternatives)
     if not r.found:
         return [], r.programs
+    judged = r.programs
     found = [r.program] + [a.program for a in r.alternatives]
-    order = sorted(range(len(found)), key=lambda i: (-progress(found[i], pairs, cfg, graded), i))
-    return [found[i] for i in order][: settings.tries], r.programs
+    score = {p: progress(p, pairs, cfg, graded) for p in found}
+    for _ in range(settings.further):
+        if allowance is not None and not allowance.take(settings.budget):
+            break
+        more = Searcher(ProgressBackend(cfg, graded, above=max(score.values())), width=1)
+        r = more.search(chain, task, settings.budget)
+        judged += r.programs
+        if allowance is not None and r.found:  # it stopped at what it found: the rest given back
+            allowance.left += settings.budget - min(settings.budget, r.rank)
+        if not r.found:
+            break
+        found.append(r.program)
+        score[r.program] = progress(r.program, pairs, cfg, graded)
+    order = sorted(range(len(found)), key=lambda i: (-score[found[i]], i))
+    return [found[i] for i in order][: settings.tries], judged
 
 
 def joins(first: Program, rest: Program) -> list[Program]:
@@ -204,7 +230,7 @@ def learn_in_parts(pairs: Sequence[tuple[Scene, Scene]], chain_of: Callable[[Seq
     if settings.max_parts < 2 or not allowance.take(settings.budget):
         return None, 0
     whole = chain_of(pairs)
-    firsts, judged = first_parts(whole, pairs, settings, cfg)
+    firsts, judged = first_parts(whole, pairs, settings, cfg, allowance=allowance)
     fitting: list[tuple[float, Program, tuple[Program, ...]]] = []  # (nats, join, parts), in the order found
     for first in firsts:
         if not allowance.take(settings.budget):
@@ -256,7 +282,7 @@ def continued(whole: Chain, pairs: Sequence[tuple[Scene, Scene]], searcher: Sear
     it (`Searcher.search` with a prefix), on the whole pairs and their chain. Where none
     fits, the first parts' `remembering` variants are continued the same way, each on a
     tenth of a part's budget."""
-    firsts, judged = first_parts(whole, pairs, settings, cfg, graded=True)
+    firsts, judged = first_parts(whole, pairs, settings, cfg, graded=True, allowance=allowance)
     task = Task.from_pairs(pairs, cfg)
     fitting: list[tuple[float, Program, tuple[Program, ...]]] = []
 

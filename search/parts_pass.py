@@ -10,7 +10,7 @@ ranks far past the budget, while each half, under that model, is among the first
 thousand. Those are then tried with `search.parts.learn_in_parts` (a first part that
 brings every example closer to its output, the rest from what it makes, the join
 checked on every pair by the reference machine), each part's search a tenth of the
-budget and all of them together at most 1.1 budgets. So the pass costs at most 2.1
+budget and all of them together at most 1.3 budgets. So the pass costs at most 2.3
 budgets per missed concept.
 
 Its records carry the iteration number `max_iterations` (past every iteration's),

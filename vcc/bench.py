@@ -217,6 +217,10 @@ def cmd_bench_reproduce(a: argparse.Namespace) -> int:
                 print(f"  kept: {out} holds this row finished under settings since changed (its run.json says "
                       "which; the report gives them); move the folder aside to run it with today's")
                 continue
+            if a.redo_last_pass:
+                aside = rp.set_last_pass_aside(out)
+                print(f"  its last pass searched anew; the earlier one's records -> {aside}" if aside else
+                      "  no finished last pass to search anew")
             try:
                 s = rp.run_row(row, names, out, a.scale, a.dataset, a.width, not a.quiet, searcher)
             except KeyboardInterrupt:
@@ -328,6 +332,9 @@ def add_commands(sub) -> None:
                    help="concepts searched in lockstep (default 32)")
     runtime.cluster_flags(r, "search each iteration's concepts on Ray workers, --width concepts a chunk; "
                              "the same results")
+    r.add_argument("--redo-last-pass", action="store_true",
+                   help="search each finished row's last pass anew (after a change to it alone); the earlier "
+                        "pass's records are kept as last-pass-K.jsonl in the row folder")
     r.add_argument("--quiet", action="store_true", help="no progress bars")
     _report_flags(r)
     r.set_defaults(fn=cmd_bench_reproduce)

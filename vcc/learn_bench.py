@@ -39,9 +39,10 @@ STARTS = ("library", "uniform")
 # 6: fill_color's arguments from the colours objects gain (`argpred.gained`), not the network;
 # 7: filter values the objects acted on rule out dropped (`argpred.acted`); 8: first parts
 # continued once more with a fixation added (`search.parts.remembering`); 9: filter values
-# the pairs point in raised (`argpred.acted`, `--filters acted+raised`)
+# the pairs point in raised (`argpred.acted`, `--filters acted+raised`); 10: searches for a
+# first part of more progress than those kept (`search.parts.first_parts`)
 # (a run of another protocol is refused)
-PROTOCOL = 9
+PROTOCOL = 10
 # What every results line must hold (the key of `_key`, and whether it was found).
 RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 

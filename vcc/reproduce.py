@@ -135,6 +135,31 @@ def finished_otherwise(out: Path, settings: Settings) -> dict | None:
     return None if same_search(recorded, dataclasses.asdict(settings)) else recorded
 
 
+def set_last_pass_aside(out: Path) -> Path | None:
+    """For `--redo-last-pass`: a finished row's last-pass records moved to
+    `last-pass-K.jsonl` (K the first number free) and its summary dropped, so that running
+    the row again searches its last pass anew, with today's code, and the iterations'
+    records stay (the same searches). The path they went to, or None where the folder
+    holds no finished run with a last pass."""
+    from search.induce import read_records
+
+    results, done = out / "results.jsonl", out / "summary.json"
+    if not done.exists():
+        return None
+    files.hold(out)  # no run may write the folder meanwhile
+    read_records(results)  # checked first: a foreign or corrupt file is refused in one line
+    lines = [line for line in results.read_text().splitlines() if line.strip()]
+    moved = [line for line in lines if json.loads(line).get("last_pass")]
+    if not moved:
+        return None
+    k = next(k for k in range(len(lines) + 1) if not (out / f"last-pass-{k}.jsonl").exists())
+    aside = out / f"last-pass-{k}.jsonl"
+    files.write_whole(aside, "\n".join(moved) + "\n")
+    done.unlink()  # before the records change: cut here, the row resumes as it was
+    files.write_whole(results, "".join(line + "\n" for line in lines if not json.loads(line).get("last_pass")))
+    return aside
+
+
 def read_row(path: Path) -> dict | None:
     """A row folder's figures: its summary when the run finished, else what its records say
     so far (marked partial). None when the folder holds no run."""

@@ -105,6 +105,32 @@ def test_bench_reproduce_runs_rows_resumes_and_reports_the_rest_as_not_run(tmp_p
     assert "other settings" in capsys.readouterr().err and (main_row / "results.jsonl").read_text() == lines
 
 
+def test_bench_reproduce_searches_a_rows_last_pass_anew_keeping_its_iterations(tmp_path, capsys):
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M")) == 0
+    row = next((tmp_path / "runs").iterdir())
+    lines = (row / "results.jsonl").read_text().splitlines()
+    last = [line for line in lines if json.loads(line).get("last_pass")]
+    assert last  # swap_locations is missed at this budget: the pass searched it
+    found = json.loads((row / "summary.json").read_text())["found"]
+    capsys.readouterr()
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M", "--redo-last-pass")) == 0
+    assert "last-pass-0.jsonl" in capsys.readouterr().out
+    assert (row / "last-pass-0.jsonl").read_text().splitlines() == last  # the earlier pass kept aside
+    again = (row / "results.jsonl").read_text().splitlines()
+    assert again[: len(lines) - len(last)] == [line for line in lines if line not in last]  # iterations kept
+    redone = [json.loads(line) for line in again[len(lines) - len(last):]]
+    old = [json.loads(line) for line in last]
+    assert [(r["concept"], r["found"], r["program"]) for r in redone] == [
+        (r["concept"], r["found"], r["program"]) for r in old]  # the same code searches the same
+    assert {r["session"] for r in redone} == {len(json.loads((row / "run.json").read_text())["sessions"]) - 1}
+    assert json.loads((row / "summary.json").read_text())["found"] == found
+    # a row with no finished last pass is left as it is
+    (row / "summary.json").unlink()
+    before = (row / "results.jsonl").read_text()
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M", "--redo-last-pass")) == 0
+    assert (row / "results.jsonl").read_text() == before and not (row / "last-pass-1.jsonl").exists()
+
+
 def _emulator_result(date: str, commit: str, ratio: float, per_instruction: dict, k: int) -> dict:
     """A small emulator result of the shape `vcc bench emulator` writes (its figures made up,
     scaled by k so that two files' tables differ)."""
