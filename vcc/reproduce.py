@@ -147,8 +147,9 @@ def set_last_pass_aside(out: Path) -> Path | None:
     if not done.exists():
         return None
     files.hold(out)  # no run may write the folder meanwhile
-    read_records(results)  # checked first: a foreign or corrupt file is refused in one line
-    lines = [line for line in results.read_text().splitlines() if line.strip()]
+    records = read_records(results)  # checked first: a foreign or corrupt file is refused in one line
+    # the records' lines as written (a last line cut by an interrupt, which reading drops, goes)
+    lines = [line for line in results.read_text().splitlines() if line.strip()][: len(records)]
     moved = [line for line in lines if json.loads(line).get("last_pass")]
     if not moved:
         return None

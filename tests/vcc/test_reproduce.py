@@ -70,11 +70,24 @@ def test_bench_reproduce_searches_a_rows_last_pass_anew_keeping_its_iterations(t
         (r["concept"], r["found"], r["program"]) for r in old]  # the same code searches the same
     assert {r["session"] for r in redone} == {len(json.loads((row / "run.json").read_text())["sessions"]) - 1}
     assert json.loads((row / "summary.json").read_text())["found"] == found
+    # a last line cut by an interrupt is dropped with the pass; a bad line elsewhere is
+    # refused in one line, and nothing is moved
+    (row / "results.jsonl").write_text("\n".join(again) + '\n{"concept": "swap_lo')
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M", "--redo-last-pass")) == 0
+    assert (row / "last-pass-1.jsonl").read_text().splitlines() == again[len(lines) - len(last):]
+    good = (row / "results.jsonl").read_text()
+    (row / "results.jsonl").write_text("not json\n" + good)
+    capsys.readouterr()
+    assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M", "--redo-last-pass")) != 0
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "results.jsonl" in err and not (row / "last-pass-2.jsonl").exists()
+    assert (row / "summary.json").exists()
+    (row / "results.jsonl").write_text(good)
     # a row with no finished last pass is left as it is
     (row / "summary.json").unlink()
     before = (row / "results.jsonl").read_text()
     assert main(_reproduce(tmp_path, "--rows", "o1-predfix-0.5M", "--redo-last-pass")) == 0
-    assert (row / "results.jsonl").read_text() == before and not (row / "last-pass-1.jsonl").exists()
+    assert (row / "results.jsonl").read_text() == before and not (row / "last-pass-2.jsonl").exists()
 
 
 def test_bench_reproduce_refuses_an_unknown_row_or_scale(tmp_path, capsys):
