@@ -10,9 +10,8 @@ Reference programs are read only to make examples and, for `--args oracle` and t
 teacher's fixation guidance, for their arguments.
 
 Files under `out/`: `run.json` (the settings and each concept's examples hash; a
-resume must match them),
-`results.jsonl` (one line per concept tried per iteration, written as soon as it is
-known), `model-K.json` (the model searched with in iteration K).
+resume must match them), `results.jsonl` (one line per concept tried per iteration,
+written as soon as it is known), `model-K.json` (the model searched with in iteration K).
 """
 
 from __future__ import annotations
