@@ -176,8 +176,8 @@ def first_parts(chain: Chain, pairs: Sequence[tuple[Scene, Scene]], settings: Pa
         more = Searcher(ProgressBackend(cfg, graded, above=max(score.values())), width=1)
         r = more.search(chain, task, settings.budget)
         judged += r.programs
-        if allowance is not None and r.found:  # it stopped at what it found: the rest given back
-            allowance.left += settings.budget - min(settings.budget, r.rank)
+        if allowance is not None and r.found:
+            allowance.give_back(settings.budget - min(settings.budget, r.rank))
         if not r.found:
             break
         found.append(r.program)
@@ -211,6 +211,10 @@ class _Allowance:
             return False
         self.left -= budget
         return True
+
+    def give_back(self, unused: int) -> None:
+        """Return what a search took but did not cover (it stopped at what it found)."""
+        self.left += unused
 
 
 def learn_in_parts(pairs: Sequence[tuple[Scene, Scene]], chain_of: Callable[[Sequence[tuple[Scene, Scene]]], Chain],

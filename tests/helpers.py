@@ -50,7 +50,6 @@ def run_both(program: Program | str, sc: Scene, cfg: VCCConfig = DEFAULT_CONFIG)
     return ref, st
 
 
-
 def reference_pairs(program: str, scenes: list[Scene]) -> list[tuple[Scene, Scene]]:
     """(input, output) of the reference machine running `program` on each scene; a failing
     run is no example."""

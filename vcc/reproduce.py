@@ -150,14 +150,15 @@ def set_last_pass_aside(out: Path) -> Path | None:
     records = read_records(results)  # checked first: a foreign or corrupt file is refused in one line
     # the records' lines as written (a last line cut by an interrupt, which reading drops, goes)
     lines = [line for line in results.read_text().splitlines() if line.strip()][: len(records)]
-    moved = [line for line in lines if json.loads(line).get("last_pass")]
+    in_pass = [bool(r.get("last_pass")) for r in records]
+    moved = [line for line, p in zip(lines, in_pass) if p]
     if not moved:
         return None
     k = next(k for k in range(len(lines) + 1) if not (out / f"last-pass-{k}.jsonl").exists())
     aside = out / f"last-pass-{k}.jsonl"
     files.write_whole(aside, "\n".join(moved) + "\n")
     done.unlink()  # before the records change: cut here, the row resumes as it was
-    files.write_whole(results, "".join(line + "\n" for line in lines if not json.loads(line).get("last_pass")))
+    files.write_whole(results, "".join(line + "\n" for line, p in zip(lines, in_pass) if not p))
     return aside
 
 
