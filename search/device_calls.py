@@ -1,11 +1,14 @@
-"""Device calls over rows of host arrays: padded to a few batch sizes, split over the
+"""Device calls over rows of host arrays: padded to a few batch sizes, dealt out to the
 devices, started without waiting, compile time kept apart.
 
 A search steps batches of every size; XLA compiles a function once per input shape, so
 each batch is cut into pieces of a few fixed sizes (buckets) and each piece padded to
-its size by repeating a row. Each piece is split by rows over the JAX devices (a
-one-axis mesh: each device runs its share). Pieces are dispatched without waiting for
-the results, so the host prepares the next while the device runs one.
+its size by repeating a row. With several devices the pieces are dealt out whole, one
+device each in turn, and a batch too small to give every device a piece is cut into one
+near-equal piece per device: each device runs its own pieces while the others run
+theirs (on a CPU host, `XLA_FLAGS=--xla_force_host_platform_device_count=N` makes N
+devices, one per core: `vccjax.runtime.prepare`). Pieces are dispatched without waiting
+for the results, so the host prepares the next while the devices run.
 """
 
 from __future__ import annotations
@@ -16,12 +19,11 @@ from collections.abc import Callable, Hashable, Iterable, Iterator, Sequence
 
 import jax
 import numpy as np
-from jax.sharding import Mesh, NamedSharding
-from jax.sharding import PartitionSpec as P
 
 CALL_ROWS = 8  # a device call's fixed cost, in rows stepped
 BUCKETS = (16, 64, 256, 1024, 4096)  # the search's padded batch sizes
 
+MIN_SHARE = 16  # rows a device must get before a small batch is cut into one piece per device
 RowsOf = Callable[..., object]  # `rows_of(a)` / `rows_of(a, via)`: a host array's rows for one piece
 Pending = list[tuple[np.ndarray, object]]  # (rows of each piece, its device outputs with the padding)
 
@@ -44,42 +46,54 @@ def piece_sizes(n: int, buckets: Sequence[int]) -> list[int]:
     return [buckets[-1]] * full + (list(_cheapest_cover(rest, buckets)) if rest else [])
 
 
+def dealt_pieces(n: int, buckets: Sequence[int], devices: int) -> list[tuple[int, int, int]]:
+    """(rows, padded size, device index) of the pieces covering n rows in order: one
+    device's `piece_sizes`; over several devices, at least one piece per device when each
+    gets `MIN_SHARE` rows or more, the pieces near-equal (a multiple of the device count
+    of them, each padded to the least bucket that holds it), dealt out in turn."""
+    buckets = tuple(sorted(buckets))
+    sizes = piece_sizes(n, buckets)
+    if devices == 1 or n < devices * MIN_SHARE:
+        return [(min(size, n - sum(sizes[:k])), size, 0) for k, size in enumerate(sizes)]
+    k = -(-max(len(sizes), devices) // devices) * devices
+    rows = [n // k + (i < n % k) for i in range(k)]
+    return [(r, next(b for b in buckets if b >= r), i % devices) for i, r in enumerate(rows)]
+
+
 class DeviceCalls:
     """Runs calls over rows in bucket-sized pieces on `devices` (default: all JAX devices),
-    counting the first call of each (key, size) as compile time."""
+    counting the first call of each (key, size, device) as compile time."""
 
     def __init__(self, buckets: Sequence[int], devices: Sequence[jax.Device] | None = None):
         self.devices = list(devices) if devices is not None else jax.devices()
-        if any(b % len(self.devices) for b in buckets):
-            raise ValueError(f"batch sizes {tuple(buckets)} must divide over {len(self.devices)} devices")
-        mesh = Mesh(np.array(self.devices), ("rows",))
-        self.split_by_rows = NamedSharding(mesh, P("rows"))  # each device a share of the rows
-        self.everywhere = NamedSharding(mesh, P())  # a copy on each device
         self.buckets = tuple(sorted(buckets))
-        self.compiled: set[tuple] = set()  # (key, size) seen
-        self.compile_seconds = 0.0  # first calls of each (key, size): compile time, kept apart
+        self.compiled: set[tuple] = set()  # (key, size, device) seen
+        self.compile_seconds = 0.0  # first calls of each (key, size, device): compile time, kept apart
+        self.rows_run = [0] * len(self.devices)  # rows (padding not counted) each device was given
 
     def start(self, key: Hashable, rows: np.ndarray, call: Callable[[RowsOf], object],
               sizes: Sequence[int] | None = None) -> Pending:
         """Start `call(rows_of)` over `rows` in bucket-sized pieces (`sizes`, default this
-        caller's buckets; each padded by repeating its first row; `rows_of(a)` gives a host
-        array's rows of the piece, `rows_of.real` its rows before the padding) without
-        waiting for the results. First calls of a (key, size) compile synchronously and are timed
-        as compile time. Returns the pending pieces, for `results`."""
+        caller's buckets; each padded by repeating its first row), dealt out to the devices
+        (`dealt_pieces`), without waiting for the results. `rows_of(a)` gives a host array's
+        rows of the piece on its device, `rows_of.real` its rows before the padding,
+        `rows_of.device` the device (what else the call reads must be there). First calls
+        of a (key, size, device) compile synchronously and are timed as compile time.
+        Returns the pending pieces, for `results`."""
         offset, pending = 0, []
-        for size in piece_sizes(len(rows), sizes) if sizes else self.piece_sizes(len(rows)):
-            piece = rows[offset : offset + size]
+        for real, size, d in dealt_pieces(len(rows), sizes or self.buckets, len(self.devices)):
+            piece = rows[offset : offset + real]
             padded = np.concatenate([piece, np.full(size - len(piece), piece[0])])
-            first = (key, size) not in self.compiled
+            first = (key, size, d) not in self.compiled
             t0 = time.perf_counter()
-            rows_of = self.rows_on_devices(padded)
-            rows_of.real = len(piece)  # the piece's rows before the padding
+            rows_of = self.rows_on_device(padded, d, real)
             pending.append((piece, call(rows_of)))
             if first:
                 jax.block_until_ready(pending[-1][1])
-                self.compiled.add((key, size))
+                self.compiled.add((key, size, d))
                 self.compile_seconds += time.perf_counter() - t0
-            offset += size
+            self.rows_run[d] += real
+            offset += real
         return pending
 
     @staticmethod
@@ -93,13 +107,18 @@ class DeviceCalls:
         """`start` and `results` at once."""
         return self.results(self.start(key, rows, call, sizes))
 
-    def rows_on_devices(self, padded: np.ndarray) -> RowsOf:
-        """What `call` gets: `rows_of(a)`, the padded rows of a host array (`rows_of(a, via)`:
-        rows `via[padded]` of it), split over the devices by rows when there are several
-        (XLA then runs each device's share)."""
+    def rows_on_device(self, padded: np.ndarray, d: int = 0, real: int | None = None) -> RowsOf:
+        """What `call` gets for a piece on device `d` whose first `real` rows (default all)
+        are its own: `rows_of(a)`, the padded rows of a host array (`rows_of(a, via)`: rows
+        `via[padded]` of it), put on that device (with one device, handed over as they
+        are: the jitted call moves them)."""
+        device = self.devices[d]
+
         def rows_of(a: np.ndarray, via: np.ndarray | None = None):
             rows = a[padded if via is None else via[padded]]
-            return rows if len(self.devices) == 1 else jax.device_put(rows, self.split_by_rows)
+            return rows if len(self.devices) == 1 else jax.device_put(rows, device)
+        rows_of.real = len(padded) if real is None else real
+        rows_of.device = device
         return rows_of
 
     def piece_sizes(self, n: int) -> list[int]:

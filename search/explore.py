@@ -25,7 +25,7 @@ import numpy as np
 
 from search.backend import Backend, Reply, Request
 from search.chain import Chain
-from search.device_calls import BUCKETS, RowsOf
+from search.device_calls import BUCKETS
 from search.dfs import MAX_PORTIONS, Alternatives, depth_first
 from search.jax_backend import JaxBackend
 from search.lockstep import search_in_lockstep
@@ -76,8 +76,9 @@ class Searcher:
 
 class Explorer(Searcher):
     """The search on the JAX emulator (`search.jax_backend.JaxBackend`); one instance keeps
-    its compiled steps. Batches are padded to one of `buckets` sizes and split by rows
-    over `devices` (default: all JAX devices); `width` concepts share a lockstep round."""
+    its compiled steps. Batches are padded to one of `buckets` sizes, their pieces dealt
+    out to `devices` (default: all JAX devices; `search.device_calls`); `width` concepts
+    share a lockstep round."""
 
     backend: JaxBackend
 
@@ -98,8 +99,3 @@ class Explorer(Searcher):
     def compile_seconds(self) -> float:
         """Seconds spent compiling, all searches so far."""
         return self.backend.compile_seconds
-
-    def _rows_of(self, padded: np.ndarray) -> RowsOf:
-        """`DeviceCalls.rows_on_devices`: a batch's rows as the devices get them (tests check
-        that a batch is split over the devices)."""
-        return self.backend.calls.rows_on_devices(padded)

@@ -2,8 +2,9 @@
 one device call per piece of a round's rows.
 
 The concepts being searched have their example scenes and targets in a bank of
-`width` slots on the device (a fixed shape: each instruction compiles once whatever the
-number of concepts); a batch's rows are programs, each reading its concept's slot.
+`width` slots on each device (a fixed shape: each instruction compiles once whatever the
+number of concepts); a batch's rows are programs, each reading its concept's slot in
+the bank of the device its piece was dealt to (`search.device_calls`).
 On the host a prefix's states are one packed int32 row per example (`search.packing`),
 so a frame is one array and a transfer one copy. A round's children, whatever their
 instructions, are stepped by all their atoms (a subroutine is several, in turn) with
@@ -114,9 +115,9 @@ class JaxBackend:
     def __init__(self, cfg: VCCConfig = DEFAULT_CONFIG, buckets: Sequence[int] = BUCKETS,
                  width: int = 32, devices: Sequence[jax.Device] | None = None):
         self.cfg = cfg
-        self.calls = DeviceCalls(buckets, devices)  # every batch split by rows over these devices
+        self.calls = DeviceCalls(buckets, devices)  # every batch's pieces dealt out to these devices
         self.width = width  # bank slots: tasks run at once
-        self._bank: tuple[SceneConst, Target] | None = None  # (width, E, ...), a copy on each device
+        self._bank: dict[jax.Device, tuple[SceneConst, Target]] = {}  # (width, E, ...) on each device
         self._bank_examples = 0  # E of the bank
         self._slot_of: dict[int, int] = {}  # id(task) -> bank slot
         self._room: np.ndarray | None = None  # see `_children_room`
@@ -165,13 +166,13 @@ class JaxBackend:
     def _load(self, slot: int, task: Task) -> None:
         """Put a task's scenes and targets in a bank slot (a new bank if the example count
         differs from the current one's)."""
-        everywhere = self.calls.everywhere
-        if self._bank is None or self._bank_examples != task.n_examples:
-            self._bank = jax.device_put(jax.tree.map(lambda a: jnp.broadcast_to(a, (self.width,) + a.shape),
-                                                     (task.consts, task.targets)), everywhere)
+        if not self._bank or self._bank_examples != task.n_examples:
+            empty = jax.tree.map(lambda a: jnp.broadcast_to(a, (self.width,) + a.shape), (task.consts, task.targets))
+            self._bank = {d: jax.device_put(empty, d) for d in self.calls.devices}
             self._bank_examples = task.n_examples
             self._slot_of = {}
-        self._bank = _put_in_slot(self._bank, slot, jax.device_put((task.consts, task.targets), everywhere))
+        for d, bank in self._bank.items():
+            self._bank[d] = _put_in_slot(bank, slot, jax.device_put((task.consts, task.targets), d))
         self._slot_of = {k: v for k, v in self._slot_of.items() if v != slot}
         self._slot_of[id(task)] = slot
 
@@ -198,10 +199,10 @@ class JaxBackend:
         rows = np.nonzero((ops[:, 0] >= 0) & ~failed)[0]
         if len(rows) == 0:
             return
-        cfg, (consts, _) = self.cfg, self._bank
+        cfg, bank = self.cfg, self._bank
         pending = self.calls.start(
             ("advance", source.shape[1]), rows,
-            lambda rows_of: _advance_packed(cfg, consts, rows_of(slots), rows_of(source, source_row),
+            lambda rows_of: _advance_packed(cfg, bank[rows_of.device][0], rows_of(slots), rows_of(source, source_row),
                                             rows_of(ops), rows_of(args), rows_of.real),
             STEP_ROWS)
         for piece, (new, fails) in self.calls.results(pending):
@@ -225,11 +226,10 @@ class JaxBackend:
         cfg, examples = self.cfg, children.shape[1]
         verdicts = np.zeros((len(children), examples), np.int32)
         if len(judged):
-            consts, targets = self._bank
-            boards = _blackboards(children, cfg)
+            bank, boards = self._bank, _blackboards(children, cfg)
             for rows, found in self.calls.run(
                     ("judge", examples), judged,
-                    lambda rows_of: _device_verdicts(cfg, consts, targets, rows_of(slots), rows_of(boards))):
+                    lambda rows_of: _device_verdicts(cfg, *bank[rows_of.device], rows_of(slots), rows_of(boards))):
                 verdicts[rows] = found
         solved = ~failed & np.all(verdicts == YES, axis=1)
         for i in np.nonzero(~failed & ~solved & np.all((verdicts == YES) | (verdicts == ASK), axis=1))[0]:
