@@ -21,7 +21,6 @@ import time
 from collections.abc import Callable, Sequence
 
 import jax
-import numpy as np
 
 from search.backend import Backend, Reply, Request
 from search.chain import Chain
