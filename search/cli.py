@@ -26,7 +26,6 @@ def cmd_induce(a: argparse.Namespace) -> int:
     else:
         names = concept_list(a.concepts)
     start = start_model(a.model, settings) if a.model else None
-    runtime.prepare(searches=True)  # before the predictor's weights touch a device
     if settings.args.startswith("predicted"):
         from argpred.predict import default_predictor
 
@@ -34,6 +33,7 @@ def cmd_induce(a: argparse.Namespace) -> int:
     if a.dataset and needs_answer(settings):
         for c in names:  # refuse now, not after an hour, a concept without a stored answer
             ds.program(c)
+    runtime.prepare()
     if not a.dataset:
         ds = dataset_for(names, a.seed, a.dataset, progress=not a.quiet)
     for c in names:  # every concept's examples read and checked before the run folder is touched

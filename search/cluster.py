@@ -36,7 +36,7 @@ class _Worker:
         from vccjax.actor_pool import pin
 
         pin(slot, threads)
-        runtime.prepare(searches=True)
+        runtime.prepare()
         from search.explore import Explorer
 
         self.explorer = Explorer(width=width)

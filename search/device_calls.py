@@ -7,8 +7,8 @@ its size by repeating a row. With several devices the pieces are dealt out whole
 device each in turn, and a batch too small to give every device a piece is cut into one
 near-equal piece per device: each device runs its own pieces while the others run
 theirs (on a CPU host, `XLA_FLAGS=--xla_force_host_platform_device_count=N` makes N
-devices: `vccjax.runtime.device_per_core`). Pieces are dispatched without waiting for
-the results, so the host prepares the next while the devices run.
+devices). Pieces are dispatched without waiting for the results, so the host prepares
+the next while the devices run.
 """
 
 from __future__ import annotations

@@ -108,7 +108,7 @@ def cmd_learn(a: argparse.Namespace) -> int:
     files = [f"{p.name}:{hashlib.sha256(p.read_bytes()).hexdigest()[:16]}"
              for _, fin, fout in pair_files(a.examples) for p in (fin, fout)]
     pairs = [(i, o) for _, i, o in examples]
-    runtime.prepare(searches=True)
+    runtime.prepare()
     from tqdm import tqdm
 
     print(f"{len(pairs)} pairs from {a.examples}; library: {settings.library}; arguments: {settings.args}"

@@ -58,10 +58,11 @@ def _search_jobs(a: argparse.Namespace):
 def cmd_bench_search(a: argparse.Namespace) -> int:
     """The same concepts searched by the batched explorer (all concepts in lockstep) and by
     the scalar-driven one, same chains and budget: programs/s and their ratio."""
+    from vccjax.runtime import enable_compile_cache
     from search.explore import Explorer
     from search.scalar import ScalarExplorer
 
-    runtime.prepare(searches=True)
+    enable_compile_cache()
     names, jobs = _search_jobs(a)
     explorer = Explorer(width=a.width)
     warm: dict = {}
@@ -185,6 +186,7 @@ def cmd_bench_emulator(a: argparse.Namespace) -> int:
 
 def cmd_bench_reproduce(a: argparse.Namespace) -> int:
     """Run the chosen rows (each resumable), then write the results JSON and the report."""
+    from vccjax.runtime import enable_compile_cache
     from vccjax.world.concepts import concept_list
     from vcc import reproduce as rp
 
@@ -201,7 +203,7 @@ def cmd_bench_reproduce(a: argparse.Namespace) -> int:
     runs = Path(a.runs)
     searcher = None
     if rows:
-        runtime.prepare(searches=True)
+        enable_compile_cache()
         if cluster:  # each iteration's concepts in chunks of --width to Ray workers
             from search.cluster import ClusterSearcher
 

@@ -23,7 +23,7 @@ def cmd_bench_cluster(a: argparse.Namespace) -> int:
     ray_module()
     if a.width < a.workers:
         raise ValueError(f"--width {a.width}: at least --workers ({a.workers}), each worker takes width/workers")
-    runtime.prepare(searches=True)
+    runtime.prepare()
     names, jobs = _search_jobs(a)
 
     def timed(searcher) -> tuple[dict, float, float]:

@@ -84,7 +84,7 @@ def cmd_bench_learn(a: argparse.Namespace) -> int:
 
     examples = sorted({int(k) for k in a.examples.split(",")}, reverse=True)
     programs = read_programs(a.programs)
-    runtime.prepare(searches=True)
+    runtime.prepare()
     run = Path(a.run)
     asking = LearnSettings(budget=a.budget)
     head = {"protocol": PROTOCOL, "budget": a.budget, "examples": examples, "ask_examples": a.ask_examples,

@@ -119,7 +119,7 @@ def why_missed(folder: Path, others: list[Path] = (), model_index: int | None = 
 def cmd_bench_misses(a: argparse.Namespace) -> int:
     from vcc.bench import stamp
 
-    runtime.prepare(searches=True)
+    runtime.prepare()
     others = [Path(x) for x in a.known.split(",") if x.strip()]
     concepts = [c for c in a.concepts.split(",") if c] if a.concepts else None
     report = {**stamp(a, "misses"), "benchmark": "misses",

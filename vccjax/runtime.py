@@ -53,41 +53,13 @@ def enable_compile_cache() -> None:
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.0)
 
 
-HOST_DEVICES_MAX = 8  # XLA host devices a searching process makes at most
-
-
-def device_per_core() -> None:
-    """One XLA host device per core this process may use (at most HOST_DEVICES_MAX): the
-    search deals a round's pieces out to the devices and each device runs its own
-    (`search.device_calls`), where one device runs one piece at a time.
-    VCCJAX_HOST_DEVICES sets another count; a count already in XLA_FLAGS is kept. Only
-    the CPU platform is split: on a GPU host the search uses the GPUs."""
-    flag = "--xla_force_host_platform_device_count"
-    if flag in os.environ.get("XLA_FLAGS", ""):
-        return
-    given = os.environ.get("VCCJAX_HOST_DEVICES")
-    if given is not None:
-        if not given.isdigit() or int(given) < 1:
-            raise ValueError(f"VCCJAX_HOST_DEVICES={given!r}: give a whole number, 1 or more")
-        n = int(given)
-    else:
-        cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-        n = min(cores, HOST_DEVICES_MAX)
-    if n > 1:
-        add_xla_flags(f"{flag}={n}")
-
-
-def prepare(xla_flags: Sequence[str] = (), cores: int | None = None, compile_cache: bool = True,
-            searches: bool = False) -> None:
+def prepare(xla_flags: Sequence[str] = (), cores: int | None = None, compile_cache: bool = True) -> None:
     """Set a process up for a command: flags and cores first (before JAX starts), then
-    the compile cache. A command that `searches` gets a host device per core
-    (`device_per_core`)."""
+    the compile cache."""
     if xla_flags:
         add_xla_flags(*xla_flags)
     if cores is not None:
         pin_to_cores(cores)
-    if searches:
-        device_per_core()
     if compile_cache:
         enable_compile_cache()
 
