@@ -53,8 +53,8 @@ def dealt_pieces(n: int, buckets: Sequence[int], devices: int) -> list[tuple[int
     of them, each padded to the least bucket that holds it), dealt out in turn."""
     buckets = tuple(sorted(buckets))
     sizes = piece_sizes(n, buckets)
-    if devices == 1 or n < devices * MIN_SHARE:
-        return [(min(size, n - sum(sizes[:k])), size, 0) for k, size in enumerate(sizes)]
+    if devices == 1 or n < devices * MIN_SHARE:  # the last piece holds what the others leave
+        return [(size, size, 0) for size in sizes[:-1]] + [(n - sum(sizes[:-1]), sizes[-1], 0)]
     k = -(-max(len(sizes), devices) // devices) * devices
     rows = [n // k + (i < n % k) for i in range(k)]
     return [(r, next(b for b in buckets if b >= r), i % devices) for i, r in enumerate(rows)]
@@ -107,17 +107,17 @@ class DeviceCalls:
         """`start` and `results` at once."""
         return self.results(self.start(key, rows, call, sizes))
 
-    def rows_on_device(self, padded: np.ndarray, d: int = 0, real: int | None = None) -> RowsOf:
-        """What `call` gets for a piece on device `d` whose first `real` rows (default all)
-        are its own: `rows_of(a)`, the padded rows of a host array (`rows_of(a, via)`: rows
-        `via[padded]` of it), put on that device (with one device, handed over as they
-        are: the jitted call moves them)."""
+    def rows_on_device(self, padded: np.ndarray, d: int, real: int) -> RowsOf:
+        """What `call` gets for a piece on device `d` whose first `real` rows are its own:
+        `rows_of(a)`, the padded rows of a host array (`rows_of(a, via)`: rows `via[padded]`
+        of it), put on that device (with one device, handed over as they are: the jitted
+        call moves them)."""
         device = self.devices[d]
 
         def rows_of(a: np.ndarray, via: np.ndarray | None = None):
             rows = a[padded if via is None else via[padded]]
             return rows if len(self.devices) == 1 else jax.device_put(rows, device)
-        rows_of.real = len(padded) if real is None else real
+        rows_of.real = real
         rows_of.device = device
         return rows_of
 

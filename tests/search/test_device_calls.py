@@ -77,4 +77,3 @@ def test_every_row_runs_once_on_its_pieces_device():
     assert np.concatenate([o for _, o in out]).tolist() == (rows * 3 + 1).tolist()
     assert calls.rows_run == [sum(r for r, _, d in dealt if d == k) for k in (0, 1)] == [150, 150]
     assert {(key, d) for key, _, d in calls.compiled} == {("times three", 0), ("times three", 1)}
-

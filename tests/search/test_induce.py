@@ -90,7 +90,6 @@ def test_concepts_explored_together_find_what_each_finds_alone(ds):
 
 _TWO_DEVICES = """  # _loop_chain's search, in a process with two devices
 import json, sys
-import numpy as np
 folder, concept, here = sys.argv[1:]
 sys.path.insert(0, here)
 from test_induce import _loop_chain
