@@ -243,7 +243,8 @@ def _write_report(a: argparse.Namespace, runs: Path) -> int:
     rows = report.collect_rows(runs)
     out = Path(a.out)
     text = report.render(out.parent, rows, st, Path(a.others) if a.others else None,
-                         Path(a.robot) if a.robot else None, runs)  # all read and checked first
+                         Path(a.robot) if a.robot else None, runs,
+                         Path(a.compiled) if a.compiled else None)  # all read and checked first
     files.write_json(out, {**st, "benchmark": "reproduce", "runs": str(runs), "rows": rows})
     files.write_whole(a.report, text)
     print(f"{len(rows)} row runs -> {out}; report -> {a.report}")
@@ -264,6 +265,9 @@ def _report_flags(p: argparse.ArgumentParser) -> None:
                    help="committed induction runs to list apart (default benchmarks/induction; '' for none)")
     p.add_argument("--robot", default="benchmarks/robot",
                    help="arm suites (folders with a summary.json) to list (default benchmarks/robot; '' for none)")
+    p.add_argument("--compiled", default="benchmarks/compile",
+                   help="cold-cache `vcc induce` runs whose compile time the targets table reads "
+                        "(default benchmarks/compile; '' for none)")
 
 
 def _concept_flags(p: argparse.ArgumentParser, sample: int) -> None:

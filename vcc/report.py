@@ -7,11 +7,10 @@ import json
 from pathlib import Path
 
 from vcc import reproduce as rp
-from vccjax import files
+from vcc.report_targets import targets_section
 from vccjax.errors import DataFileError
 
 RULED, RAISED = "the objects acted on rule out", ", those the pairs point in raised"  # `--filters` said
-TARGETS = {"emulator": 20.0, "search": 25_000, "main_wall_s": 2 * 3600, "main_found": 526, "stretch": 540}
 
 
 def _load(folder: Path) -> list[tuple[str, dict]]:
@@ -151,39 +150,6 @@ def _row_runs(rows: dict[str, dict], name: str) -> list[tuple[str, dict]]:
     """Run folders of one row: the full run first, then samples or scaled budgets."""
     got = [(k, s) for k, s in rows.items() if s.get("row") == name]
     return sorted(got, key=lambda x: (x[0] != name, x[0]))
-
-
-def targets_section(results: list[tuple[str, dict]], rows: dict[str, dict]) -> list[str]:
-    emu = _latest(results, "emulator")
-    srch = _latest(results, "search")
-    lines = ["## Targets (this 2-core CPU)", "", "| target | measured | met |", "|---|---|---|"]
-    if emu:
-        r = emu[-1][1]["main"]["ratio"]
-        lines.append(f"| JAX emulator >= {TARGETS['emulator']:.0f}x the reference, mixed stream | {r}x "
-                     f"(`{emu[-1][0]}`) | {'yes' if r >= TARGETS['emulator'] else 'no'} |")
-    else:
-        lines.append("| JAX emulator >= 20x | not run | - |")
-    if srch:
-        best = max(srch, key=lambda x: x[1]["batched"]["programs_run"] / x[1]["batched"]["seconds"])
-        b = best[1]["batched"]
-        run_rate = round(b["programs_run"] / b["seconds"])
-        lines.append(f"| search >= 25,000 programs/s, each on all 10 training examples | {run_rate:,} run to the "
-                     f"end on all examples; {b['programs_per_second']:,} searched as the paper counts (`{best[0]}`) | "
-                     f"{'yes' if run_rate >= TARGETS['search'] else 'no'} (run to the end); "
-                     f"{'yes' if b['programs_per_second'] >= TARGETS['search'] else 'no'} (paper's count) |")
-    else:
-        lines.append("| search >= 25,000 programs/s | not run | - |")
-    main = [s for k, s in _row_runs(rows, rp.MAIN) if k == rp.MAIN]
-    if main and main[0].get("complete"):
-        s = main[0]
-        ok = s["found"] >= TARGETS["main_found"] and s["wall_seconds"] <= TARGETS["main_wall_s"]
-        lines.append(f"| all 546, order 1, predicted + fixation, 0.5M: <= 2 h, >= 526 (stretch 540) | "
-                     f"{s['found']} in {s['wall_seconds'] / 3600:.2f} h | {'yes' if ok else 'no'}"
-                     f"{' (stretch too)' if s['found'] >= TARGETS['stretch'] else ''} |")
-    else:
-        lines.append(f"| all 546, order 1, predicted + fixation, 0.5M: <= 2 h, >= 526 | "
-                     f"{_cell(main[0]) if main else 'not run'} | - |")
-    return lines + [""]
 
 
 def other_runs_section(folder: Path) -> list[str]:
@@ -364,7 +330,7 @@ def collect_rows(runs: Path) -> dict[str, dict]:
 
 
 def render(results_dir: Path, rows: dict[str, dict], stamp: dict, others: Path | None = None,
-           robot: Path | None = None, runs: Path | None = None) -> str:
+           robot: Path | None = None, runs: Path | None = None, compiled: Path | None = None) -> str:
     """The report's text; a result file, row or run of the wrong shape is named in one
     error line (nothing is written before the whole text is made)."""
     results = _load(results_dir)
@@ -372,7 +338,8 @@ def render(results_dir: Path, rows: dict[str, dict], stamp: dict, others: Path |
              f"Generated {stamp['date']} at commit {stamp['commit']} by `{stamp['command']}` on "
              f"{stamp['machine']['cores']} cores ({stamp['machine']['cpu']}), JAX {stamp['machine']['jax']}. "
              f"Only measured numbers: each table names its result file or run folder.", ""]
-    for section, source in ((lambda: targets_section(results, rows), f"{results_dir} or {runs}"),
+    for section, source in ((lambda: targets_section(results, rows, others, compiled),
+                             f"{results_dir}, {runs}, {others} or {compiled}"),
                             (lambda: emulator_section(results), results_dir),
                             (lambda: search_section(results), results_dir),
                             (lambda: reproduce_section(rows), runs),
@@ -392,10 +359,3 @@ def render(results_dir: Path, rows: dict[str, dict], stamp: dict, others: Path |
                                 f"({type(e).__name__}: {str(e)[:80]})") from None
     return "\n".join(lines)
 
-
-def write(results_dir: Path, rows: dict[str, dict], out: Path, stamp: dict, others: Path | None = None,
-          robot: Path | None = None) -> str:
-    """`rows`: what `collect_rows` read (the caller writes them to the results JSON too)."""
-    text = render(results_dir, rows, stamp, others, robot)
-    files.write_whole(out, text)
-    return text

@@ -1,65 +1,11 @@
-"""`vcc bench`: runs on a tiny setting, and writes a stamped result whose two
-implementations agree (speed itself is measured, never asserted)."""
+"""`vcc bench report`: what the result files and run folders hold, each section as a
+table row or line (the files written here, their figures made up)."""
 
 from __future__ import annotations
 
 import json
 
-import pytest
-
-from vcc.cli import build_parser, main
-from vccjax.errors import DataFileError
-
-
-def test_bench_search_compares_batched_and_scalar_on_the_same_concepts(tmp_path, capsys):
-    out = tmp_path / "search.json"
-    argv = ["bench", "search", "--concepts", "remove_bottom_obj,change_all_objs_color", "--budget", "2000",
-            "--width", "2", "--out", str(out)]  # examples: the dataset shipped in the package
-    assert main(argv) == 0
-    text = capsys.readouterr().out
-    r = json.loads(out.read_text())
-    assert r["results_agree"] is True and r["found"] >= 1
-    assert r["batched"]["programs_searched"] == r["scalar"]["programs_searched"] > 0
-    assert r["batched"]["nodes"] == r["scalar"]["nodes"]
-    assert r["ratio"] > 0 and f"{r['ratio']}x" in text
-    assert {"date", "commit", "machine", "command"} <= set(r) and r["machine"]["cores"] >= 1
-    again = build_parser().parse_args(r["command"].split()[1:])  # the stamped command reproduces the run
-    assert {k: v for k, v in vars(again).items() if k != "fn"} == {
-        k: v for k, v in vars(build_parser().parse_args(argv)).items() if k != "fn"}
-
-
-def test_bench_emulator_steps_a_recorded_search_stream_on_both_machines(tmp_path, capsys):
-    out = tmp_path / "emulator.json"
-    argv = ["bench", "emulator", "--concepts", "remove_bottom_obj,move_to_middle", "--per-concept", "30",
-            "--batch", "32", "--objects", "3", "--raster", "", "--repeats", "1", "--out", str(out)]
-    assert main(argv) == 0
-    text = capsys.readouterr().out
-    r = json.loads(out.read_text())
-    assert r["stream"]["programs"] == 60 and sum(r["stream"]["instructions"].values()) == 60
-    m = r["main"]
-    assert m["agree"] is True and m["programs"] == 60 and m["examples"] == 10
-    assert m["jax_programs_per_second"] > 0 and m["reference_programs_per_second"] > 0
-    assert sum(v["programs"] for v in m["per_instruction"].values()) == 60
-    assert [x["objects"] for x in r["sweeps"]["objects"]] == [3] and r["sweeps"]["objects"][0]["agree"] is True
-    assert f"mixed stream: {m['ratio']}x" in text and {"date", "commit", "machine", "command"} <= set(r)
-
-
-def test_the_recorded_stream_is_what_the_search_steps_first():
-    """Children in the search's order: the first are scene_parse's, then its children."""
-    from search.chain import Chain
-    from search.explore import Task
-    from search.induce import Settings, argument_logp
-    from search.model import MarkovModel, Vocabulary
-    from vcc.emulator_bench import record_stream
-    from vccjax.world.dataset import dataset_for
-    from vccjax.machine.instructions import OP
-
-    ds = dataset_for(["remove_bottom_obj"], 0, None, progress=False)
-    chain = Chain(Vocabulary(), MarkovModel.uniform(Vocabulary().size, 1),
-                  argument_logp(Settings(args="oracle"), "remove_bottom_obj"))
-    stream = record_stream([(chain, Task.from_pairs(ds.pairs("remove_bottom_obj", "train")))], 50)
-    assert len(stream) == 50 and stream[0][1].ops == () and stream[0][2] == OP["scene_parse"]
-    assert all(len(p) == 0 or p.ops[0] == OP["scene_parse"] for _, p, _, _ in stream)
+from vcc.cli import main
 
 
 def _emulator_result(date: str, commit: str, ratio: float, per_instruction: dict, k: int) -> dict:
@@ -83,7 +29,7 @@ def test_bench_report_reads_result_files_and_marks_a_partial_row(tmp_path, capsy
     """The report prints what its result files hold: each file's stamp, its sweeps and
     per-instruction ratios, the latest file's ratio against the target; a run folder cut
     short is marked partial. The result files are written here, their figures made up."""
-    from vcc.report import TARGETS
+    from vcc.report_targets import TARGETS
 
     res = tmp_path / "res"
     res.mkdir()
@@ -273,130 +219,3 @@ def test_a_row_says_how_its_predicted_arguments_were_taken():
                     "filters the objects acted on rule out dropped")
     assert _predicted({"args": "predicted", "fill": "gained", "filters": "acted+raised"}).endswith(
         "filters the objects acted on rule out dropped, those the pairs point in raised")
-
-
-def test_bench_emulator_cuts_batches_as_the_search_does():
-    """Each instruction's children go in the search's padded sizes (its cheapest cover,
-    capped at the bench's batch), every child once; a carry op's holding rows apart when
-    that makes the carrying calls smaller, as the search splits them."""
-    import numpy as np
-
-    from search.device_calls import BUCKETS, DeviceCalls
-    from search.stepping import EMPTY_HANDED
-    from vcc.emulator_bench import _parts, _pieces
-
-    for n, batch in [(1, 1024), (17, 1024), (300, 1024), (658, 1024), (2500, 1024), (70, 64)]:
-        pieces = _pieces(n, batch)
-        calls = DeviceCalls([b for b in BUCKETS if b < batch] + [batch])
-        assert [len(p) for p in pieces] == calls.piece_sizes(n)
-        assert sorted(set(np.concatenate(pieces).tolist())) == list(range(n))
-        assert all(len(p) <= batch and set(p.tolist()) <= set(range(n)) for p in pieces)
-
-    def group_of(held):
-        class Hand:
-            pass
-
-        class States:
-            hand = Hand
-
-        Hand.held = np.asarray(held)
-        return {"rows": np.arange(len(held)), "states": States}
-
-    carry = next(iter(EMPTY_HANDED))
-    # 4 rows, rows 1 and 3 holding on some example: both halves pad to one 16-row call,
-    # as the whole does, so splitting would only add a call.
-    small = group_of([[-1, -1], [-1, 2], [-1, -1], [0, 0]])
-    assert [p.tolist() for p in _parts(carry, small, 1024)] == [[0, 1, 2, 3]]
-    # 40 rows (three 16-row calls), 10 holding (one 16-row call): the carry runs on 16
-    # padded rows instead of 48, so the holding rows go apart.
-    held = [[-1, 0] if r % 4 == 0 else [-1, -1] for r in range(40)]
-    big = group_of(held)
-    assert [p.tolist() for p in _parts(carry, big, 1024)] == [list(range(0, 40, 4)),
-                                                             [r for r in range(40) if r % 4]]
-    assert [p.tolist() for p in _parts(-1, big, 1024)] == [list(range(40))]
-
-
-def test_bench_search_can_start_from_the_shipped_library():
-    """`--model library`: the chains search with the shipped library's vocabulary
-    (atoms and subroutines) and model, as `vcc learn` does."""
-    import numpy as np
-
-    from search.library import load
-    from vcc.bench import _search_jobs
-
-    a = build_parser().parse_args(["bench", "search", "--concepts", "remove_bottom_obj", "--model", "library"])
-    names, jobs = _search_jobs(a)
-    lib = load(None)
-    (chain, task), = jobs
-    assert names == ["remove_bottom_obj"] and task.n_examples >= 1
-    assert chain.vocab == lib.vocab and lib.vocab.bodies  # the library's subroutines, not the atoms alone
-    assert np.array_equal(chain.model.logp, lib.model.logp)
-
-
-def test_bench_search_scalar_side_can_run_a_sample(tmp_path, capsys):
-    """`--scalar-sample k`: the scalar side searches k of the concepts, evenly spread; the
-    results are compared on those, and the ratio is of programs run per second."""
-    from vcc.bench import scalar_sample
-
-    assert scalar_sample(64, 4) == [0, 16, 32, 48] and scalar_sample(3, 5) == [0, 1, 2] == scalar_sample(3, None)
-    assert len(scalar_sample(7, 3)) == 3 and len(set(scalar_sample(10, 10))) == 10
-    out = tmp_path / "search.json"
-    argv = ["bench", "search", "--concepts", "remove_bottom_obj,change_all_objs_color", "--budget", "2000",
-            "--width", "2", "--scalar-sample", "1", "--out", str(out)]
-    assert main(argv) == 0
-    r = json.loads(out.read_text())
-    assert r["scalar"]["concepts"] == ["remove_bottom_obj"] and r["results_agree"] is True
-    b, s = r["batched"], r["scalar"]
-    expected = (b["programs_run"] / b["seconds"]) / (s["programs_run"] / s["seconds"])
-    assert abs(r["ratio"] - expected) <= 0.03 * expected + 0.01  # from the seconds as stored (rounded)
-    assert "scalar over 1" in capsys.readouterr().out
-
-
-def test_bench_misses_names_the_cheapest_known_program_and_its_rank(tmp_path):
-    """A missed concept is spelt by its cheapest known program (its reference program, or a
-    cheaper one another run found that fits this run's examples) under the run's last
-    model; the rank is the same whatever the budget, and it is past a budget of 1."""
-    from search.model import MarkovModel, Vocabulary
-    from vcc.misses import why_missed
-    from vccjax.world.concepts import reference_program
-
-    missed, found = "move_to_top_edge", "remove_bottom_obj"
-    size = Vocabulary().size
-
-    def run(folder, budget):
-        folder.mkdir()
-        settings = {"budget": budget, "order": 1, "args": "oracle", "subroutines": True, "epsilon": 0.1,
-                    "max_iterations": 1, "max_subroutines": 100, "delta": 0.01}
-        (folder / "run.json").write_text(json.dumps({"format": "vccjax-induce", "version": 1, "settings": settings}))
-        rows = [{"concept": missed, "found": False, "iteration": 0},
-                {"concept": found, "found": True, "iteration": 0, "program": reference_program(found).text()}]
-        (folder / "results.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
-        (folder / "model-0.json").write_text(json.dumps({"iteration": 0, "order": 1, "subroutines": [],
-                                                         "logp": MarkovModel.uniform(size, 1).logp.tolist()}))
-        return folder
-
-    small, large = why_missed(run(tmp_path / "small", 1)), why_missed(run(tmp_path / "large", 10**12))
-    assert small["found"] == 1 and small["concepts"] == 2 and [r["concept"] for r in small["misses"]] == [missed]
-    a, b = small["misses"][0], large["misses"][0]
-    assert a["program"] == "reference" and a["rank"] == b["rank"] > 1 and a["nats"] == b["nats"] > 0
-    assert (a["why"], b["why"]) == ("past the budget", "within the budget")
-    # a shorter program found by another run for the same concept is the one spelt
-    ref = reference_program(missed)
-    other = tmp_path / "other"
-    other.mkdir()
-    assert ref.text().endswith("; release_object")  # an object left held stays where it was put
-    shorter = ref.text().removesuffix("; release_object")
-    moves_nothing = "scene_parse; top_down_attend"  # cheaper still, but fits no example
-    (other / "results.jsonl").write_text("".join(json.dumps({"concept": missed, "found": True, "program": p}) + "\n"
-                                                 for p in (moves_nothing, shorter)))
-    c = why_missed(tmp_path / "large", [tmp_path / "other"])["misses"][0]
-    assert c["program"] == shorter and c["nats"] < b["nats"] and c["rank"] < b["rank"]
-    # any concept the run searched, found or not, ranked under a chosen model: the found one's
-    # reference program is shorter than the missed one's, so it ranks before it
-    both = why_missed(tmp_path / "large", model_index=0, concepts=[found, missed])
-    assert [r["concept"] for r in both["misses"]] == [found, missed] and both["model"] == "model-0.json"
-    assert both["misses"][0]["rank"] < both["misses"][1]["rank"] == b["rank"]
-    with pytest.raises(DataFileError, match="no model-3.json"):
-        why_missed(tmp_path / "large", model_index=3)
-    with pytest.raises(DataFileError, match="searched no concept remove_top_obj"):
-        why_missed(tmp_path / "large", concepts=["remove_top_obj"])
