@@ -33,14 +33,13 @@ from search.model import MarkovModel, Vocabulary
 from search.result import Result
 from search.task import Task
 from vccjax import files
-from vccjax.errors import read_json
-from vccjax.records import Schema, append_line, check_fields, drop_cut_tail, read_jsonl
-from vccjax.world.concepts import reference_program
+from vccjax.errors import DataFileError, read_json
 from vccjax.machine.config import DEFAULT_CONFIG
-from vccjax.errors import DataFileError
 from vccjax.machine.program import Program, parse
 from vccjax.machine.reference import RefMachine
 from vccjax.machine.scene import Scene, scenes_match
+from vccjax.records import Schema, append_line, check_fields, drop_cut_tail, read_jsonl
+from vccjax.world.concepts import reference_program
 
 
 @dataclasses.dataclass(frozen=True)
