@@ -5,10 +5,13 @@ the user's inputs (the same shapes and colours, as many objects or one more, as 
 pointer when the inputs have one); programs that give the same outcome on every fresh scene
 behave alike and count as one. The examples are ambiguous when a program that behaves
 unlike the first one found gives another output on a fresh scene where the first runs
-(on at least `min_scenes` of them, so a rare tie of distances is not an alarm). The
-question put back is the fresh scene whose answer most probably leaves the right program
-as the cheapest that fits (`judge`): the user answers it by adding that input with the
-output they mean as one more pair.
+(on at least `min_scenes` of them, so a rare tie of distances is not an alarm), or when
+the first fails on a share of the fresh scenes (`DOMAIN_SHARE`) where another runs: three
+"leave it as it is" pairs of scenes that all hold a star are explained as well by "grab
+the star", which fails on every table without one. The question put back is the fresh
+scene whose answer most probably leaves the right program as the cheapest that fits
+(`judge`): the user answers it by adding that input with the output they mean as one
+more pair.
 """
 
 from __future__ import annotations
@@ -29,6 +32,11 @@ TEMPER_NATS = 3.0  # description lengths are overconfident (docs/learn.md, "Ambi
 # Fresh scenes hold as many objects as the inputs, or one more (up to this many): what a
 # concept does with one object more is what a few small examples most often leave open.
 MORE_OBJECTS_UP_TO = 8
+# The first program failing where a rival runs is ambiguity once it fails on this share
+# of the fresh scenes: a fitting program that fails on a tenth of the tables like the
+# user's leaves open what the concept does there; a rarer failure (a grab that finds no
+# object at a corner case) is not worth a question.
+DOMAIN_SHARE = 0.1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -122,6 +130,8 @@ class Verdict:
 
     programs: list[int]  # indices into the candidates: one per distinct behaviour
     disagree: list[int]  # per kept program: fresh scenes where the first runs and it differs
+    runs_where_first_fails: list[int]  # per kept program: fresh scenes where the first fails and it runs
+    first_fails: int  # fresh scenes where the first program fails
     scenes: int  # fresh scenes drawn
     ambiguous: bool
     query: int | None  # index of the fresh scene to ask about
@@ -134,10 +144,11 @@ def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int 
           nats: Sequence[float] | None = None) -> tuple[Verdict, list[Scene]]:
     """Group `candidates` (the first is the program learned; `nats`, their description
     lengths) by behaviour on fresh scenes like `inputs`, decide whether the examples are
-    ambiguous, and pick the query: the fresh scene (one the first program runs on) whose
-    answer most probably leaves the right program as the cheapest one that fits, that is
-    with the largest sum, over its outcome groups, of the group's most probable member;
-    ties go to fewer objects.
+    ambiguous, and pick the query: the fresh scene whose answer most probably leaves the
+    right program as the cheapest one that fits, that is with the largest sum, over its
+    outcome groups, of the group's most probable member; ties go to fewer objects. The
+    query is a scene the first program runs on, or, where its failures make the examples
+    ambiguous, any fresh scene (a failure is then one outcome among the others).
 
     The answer keeps one outcome group, and learning again keeps its cheapest program; if
     the right program is in that group, it is kept exactly when it is the group's most
@@ -154,7 +165,10 @@ def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int 
             kept.append(i)
     first = runs[0]
     disagree = [sum(1 for j, o in enumerate(first) if o is not None and not same(o, runs[k][j], tau)) for k in kept]
-    ambiguous = any(d >= min_scenes for d in disagree[1:])
+    elsewhere = [sum(1 for j, o in enumerate(first) if o is None and runs[k][j] is not None) for k in kept]
+    by_output = any(d >= min_scenes for d in disagree[1:])
+    by_domain = any(e >= max(min_scenes, DOMAIN_SHARE * len(scenes)) for e in elsewhere[1:])
+    ambiguous = by_output or by_domain
     dl = np.asarray(nats, float) if nats is not None else np.zeros(len(candidates))
     weight = np.exp(-(dl - dl.min()) / TEMPER_NATS)  # the model's belief in each, tempered
     query = None
@@ -164,7 +178,8 @@ def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int 
             kept_right = sum(max(weight[kept[i]] for i in g) for g in groups)
             return (-kept_right, len(scenes[j].objects), j)
 
-        usable = [j for j in range(len(scenes)) if first[j] is not None]
+        usable = [j for j in range(len(scenes)) if first[j] is not None or by_domain]
         query = min(usable, key=rank)
     outs = [runs[k][query] for k in kept] if query is not None else []
-    return Verdict(kept, disagree, len(scenes), ambiguous, query, outs, groups_of(outs, tau) if outs else []), scenes
+    return Verdict(kept, disagree, elsewhere, sum(o is None for o in first), len(scenes), ambiguous, query, outs,
+                   groups_of(outs, tau) if outs else []), scenes

@@ -90,14 +90,15 @@ class Learned:
     def ambiguous(self) -> bool:
         return bool(self.verdict and self.verdict.ambiguous)
 
-    def rivals(self) -> list[tuple[Program, str, float, int]]:
-        """(program, as searched, description length in nats, fresh scenes it parts from
-        the first on) of each program that behaves unlike the first."""
+    def rivals(self) -> list[tuple[Program, str, float, int, int]]:
+        """(program, as searched, description length in nats, fresh scenes where the first
+        runs and it parts from it, fresh scenes where the first fails and it runs) of each
+        program that behaves unlike the first."""
         if self.verdict is None:
             return []
-        cands = self.candidates()
-        return [(cands[i][0], cands[i][1], cands[i][2], d)
-                for i, d in zip(self.verdict.programs[1:], self.verdict.disagree[1:], strict=True)]
+        cands, v = self.candidates(), self.verdict
+        return [(cands[i][0], cands[i][1], cands[i][2], d, e)
+                for i, d, e in zip(v.programs[1:], v.disagree[1:], v.runs_where_first_fails[1:], strict=True)]
 
     def candidates(self) -> list[tuple[Program, str, float]]:
         r = self.result

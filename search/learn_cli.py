@@ -46,19 +46,21 @@ def concept_record(learned, examples: list[tuple[str, object, object]], files: l
     `vcc run`), how it was found, the rivals, and the examples it was learned from."""
     r = learned.result
     rivals = [{"label": _letter(k + 1), "program": p.text(), "as_searched": text, "description_length": round(dl, 4),
-               "differs_on_fresh_scenes": d}
-              for k, (p, text, dl, d) in enumerate(learned.rivals())]
+               "differs_on_fresh_scenes": d, "runs_where_learned_fails": e}
+              for k, (p, text, dl, d, e) in enumerate(learned.rivals())]
     return {
         "program": r.program.text(), "as_searched": r.text, "description_length": round(r.dl_nats, 4),
         "pairs_right": len(examples), "pairs": len(examples), "ambiguous": learned.ambiguous,
         "rivals": rivals, "fresh_scenes": learned.verdict.scenes if learned.verdict else 0,
+        "learned_fails_on_fresh_scenes": learned.verdict.first_fails if learned.verdict else 0,
         "parts": [p.text() for p in learned.parts],
         "library": learned.library, "examples": files,
         "search": {"rank": r.rank, "programs_judged": r.programs, "seconds": round(r.seconds, 3),
                    "compile_seconds": round(r.compile_seconds, 3), "budget": r.budget},
         "settings": {"budget": settings.budget, "args": settings.args, "filters": settings.filters,
                      "fixate": settings.fixate,
-                     "library": settings.library, "rival_budget": settings.rival_budget, "seed": settings.seed,
+                     "library": settings.library, "rival_budget": settings.rival_budget,
+                     "rival_margin_nats": settings.rival_margin_nats, "seed": settings.seed,
                      "parts": settings.parts},
     }
 
@@ -197,15 +199,28 @@ def _report(learned, record: dict, out: Path) -> None:
         for k, part in enumerate(learned.parts, 1):
             print(f"  part {k}: {part.text()}")
     print(f"explains {record['pairs_right']} of {record['pairs']} pairs")
+    n, fails = record["fresh_scenes"], record["learned_fails_on_fresh_scenes"]
+    if fails:
+        print(f"it fails on {fails} of {n} fresh scenes like the inputs (nothing is made there)")
     if learned.ambiguous:
         print(f"AMBIGUOUS: {len(record['rivals'])} other program(s) explain every pair but act otherwise on new scenes:")
         for rv in record["rivals"]:
-            print(f"  {rv['label']}: {rv['program']}  (differs on {rv['differs_on_fresh_scenes']} of "
-                  f"{record['fresh_scenes']} fresh scenes)")
+            where = f"differs on {rv['differs_on_fresh_scenes']} of the {n - fails} fresh scenes where it runs"
+            if fails:
+                where += f"; runs on {rv['runs_where_learned_fails']} of the {fails} where it fails"
+            print(f"  {rv['label']}: {rv['program']}  ({where})")
         print(f"question: {out / 'query.png'} (and query.json): add its input with the output you mean as a pair, "
               "and learn again")
-    elif not learned.parts:  # learned in parts: no rivals were searched (said above)
-        print(f"not ambiguous: the programs found beside it act alike on {record['fresh_scenes']} fresh scenes")
+    elif learned.parts:  # learned in parts: no rivals were searched (said above)
+        pass
+    elif len(learned.candidates()) > 1:
+        print(f"not ambiguous: the {len(learned.candidates()) - 1} other program(s) found that explain every pair "
+              f"act alike on {n} fresh scenes")
+    else:
+        st = record["settings"]
+        print(f"not ambiguous as far as searched: no other program that explains every pair was found "
+              f"({st['rival_budget']:,} programs past the first fit, up to {st['rival_margin_nats']:g} nats "
+              f"less probable)")
     print(f"wrote {out / 'concept.json'} and {out / 'trace.png'}")
 
 

@@ -79,7 +79,7 @@ def test_two_ambiguous_pairs_get_a_question_and_the_answer_settles_it(data):
     first = learn(two, settings, ScalarExplorer(width=1))
     assert first.found and _explains(first.program, two) and first.ambiguous
     rivals = first.rivals()
-    assert rivals and all(_explains(p, two) for p, _, _, _ in rivals)
+    assert rivals and all(_explains(p, two) for p, *_ in rivals)
     # the query: an input on which the rivals' outputs differ (checked on the reference)
     q = first.query_scene
     outs = [RefMachine(q).run(first.candidates()[i][0]) for i in first.verdict.programs]
