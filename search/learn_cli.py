@@ -106,7 +106,10 @@ def cmd_learn(a: argparse.Namespace) -> int:
         from vccjax.world.user_concepts import library_folder
 
         vfiles.check_writable(library_folder(), "concept library", folder=True)
-    examples = read_pairs(a.examples)  # every pair read and checked before any search
+    from argpred.features import MAX_OBJECTS
+
+    # every pair read and checked before any search
+    examples = read_pairs(a.examples, max_objects=None if settings.args == "uniform" else MAX_OBJECTS)
     files = [f"{p.name}:{hashlib.sha256(p.read_bytes()).hexdigest()[:16]}"
              for _, fin, fout in pair_files(a.examples) for p in (fin, fout)]
     pairs = [(i, o) for _, i, o in examples]

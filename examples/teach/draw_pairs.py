@@ -40,6 +40,8 @@ def main() -> None:
         if bottom is not min(scene.objects, key=lambda o: o.x):
             continue  # keep only tables whose bottom object is also the left-most
         out = RefMachine(scene).run(CONCEPT)
+        if out.failed:
+            continue  # a failed run leaves a half-made table, no output of the concept
         draw(folder / f"{k}_in.png", scene)
         draw(folder / f"{k}_out.png", out.output_scene())
         k += 1

@@ -12,6 +12,7 @@ import cv2
 import numpy as np
 import pytest
 
+from argpred.features import MAX_OBJECTS
 from search.learn import LearnSettings, learn
 from search.library import shipped_library
 from search.scalar import ScalarExplorer
@@ -152,6 +153,8 @@ def _blank(path, color=None) -> None:
 def _bad_cases(tmp_path, pairs):
     a, b = pairs[0]
     extra = Scene(a.objects + (SceneObject("star", "red", 0.9, 0.1, 0.08),), a.pointer)  # one more than the input
+    crowded = Scene(tuple(SceneObject("circle", "red", 0.15 + 0.23 * (k % 4), 0.2 + 0.3 * (k // 4), 0.08)
+                          for k in range(MAX_OBJECTS + 1)), None)
     reshaped = Scene(tuple(SceneObject("circle" if o.shape != "circle" else "square", o.color, o.x, o.y, o.width)
                            for o in a.objects[:1]), None)
     return {
@@ -169,11 +172,16 @@ def _bad_cases(tmp_path, pairs):
                                       _blank(d / "0_in.png", (200, 0, 200))), "unknown color"),
         "object from nowhere": (lambda d: _folder(d, [(a, extra)]), "never makes one"),
         "shape changed": (lambda d: _folder(d, [(a, reshaped)]), "has no"),
+        "empty table": (lambda d: _folder(d, [(Scene((), None), Scene((), None))]), "0_in.json: no objects"),
+        "one input, two outputs": (lambda d: _folder(d, [(a, b), (a, a)]), "1_out.json: its input is 0_in.json's"),
+        "more than the predictor reads": (lambda d: _folder(d, [(crowded, crowded)]),
+                                          f"0_in.json: {len(crowded.objects)} objects; the argument predictor"),
     }
 
 
 @pytest.mark.parametrize("case", ["empty", "no such folder", "half a pair", "two inputs", "stray file", "bad json",
-                                  "bad png", "no objects", "unknown colour", "object from nowhere", "shape changed"])
+                                  "bad png", "no objects", "unknown colour", "object from nowhere", "shape changed",
+                                  "empty table", "one input, two outputs", "more than the predictor reads"])
 def test_bad_examples_are_refused_in_one_line_and_nothing_is_written(data, tmp_path, capsys, case):
     make, message = _bad_cases(tmp_path, data.pairs(CONCEPT, "train"))[case]
     folder, out = tmp_path / "ex", tmp_path / "out"

@@ -28,7 +28,7 @@ class SceneObject:
             raise SceneError(f"unknown color {self.color!r}; expected one of {list(COLORS)}")
         for name in ("x", "y", "width"):
             if not _finite_number(getattr(self, name)):
-                raise SceneError(f"object {name} must be a finite number, got {str(getattr(self, name))[:40]}")
+                raise SceneError(f"object {name} must be a finite number, got {repr(getattr(self, name))[:40]}")
 
     def describe(self) -> str:
         return f"{self.color} {self.shape} at ({self.x:.3f}, {self.y:.3f}) width {self.width:.3f}"

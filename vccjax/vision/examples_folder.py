@@ -116,13 +116,29 @@ def pair_files(folder: str | Path) -> list[tuple[str, Path, Path]]:
     return out
 
 
-def read_pairs(folder: str | Path, cfg: VCCConfig = DEFAULT_CONFIG) -> list[tuple[str, Scene, Scene]]:
-    """Every pair of `folder` as (key, input scene, output scene), each checked."""
-    pairs = []
+def read_pairs(folder: str | Path, cfg: VCCConfig = DEFAULT_CONFIG,
+               max_objects: int | None = None) -> list[tuple[str, Scene, Scene]]:
+    """Every pair of `folder` as (key, input scene, output scene), each checked: an input
+    holds an object (and at most `max_objects`), its output can be made from it, and no
+    two pairs give one input two outputs (the machine is deterministic)."""
+    from vccjax.machine.scene import scenes_match
+
+    pairs, read = [], []
     for key, fin, fout in pair_files(folder):
         before, after = read_scene(fin, cfg), read_scene(fout, cfg)
+        if not before.objects:
+            raise SceneError(f"{fin}: no objects: a program acts on the input's objects, so an empty table "
+                             f"shows it nothing to learn")
+        if max_objects is not None and len(before.objects) > max_objects:
+            raise SceneError(f"{fin}: {len(before.objects)} objects; the argument predictor reads at most "
+                             f"{max_objects} (or learn with --args uniform)")
         why = unreachable(before, after)
         if why is not None:
             raise SceneError(f"{fout}: {why}")
+        for fin0, fout0, before0, after0 in read:
+            if scenes_match(before, before0, cfg.tau) and not scenes_match(after, after0, cfg.tau):
+                raise SceneError(f"{fout}: its input is {fin0.name}'s, but its output is not {fout0.name}: "
+                                 f"no program makes two outputs of one input")
+        read.append((fin, fout, before, after))
         pairs.append((key, before, after))
     return pairs
