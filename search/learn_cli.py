@@ -150,8 +150,12 @@ def cmd_learn(a: argparse.Namespace) -> int:
             os.replace(tmp / name, out / name)
     _report(learned, record, out)
     if a.save:
+        from vccjax.world.user_concepts import saved_concepts
+
+        replaced = a.name in saved_concepts()
         path = save_concept(a.name, record)
-        print(f"saved as {a.name!r} in {path.parent} (vcc run --concept {a.name})")
+        print(f"saved as {a.name!r} in {path.parent} (vcc run --concept {a.name})"
+              + ("; it replaces the concept saved under that name before" if replaced else ""))
     return 0
 
 
@@ -198,7 +202,9 @@ def _report(learned, record: dict, out: Path) -> None:
     if r.text != r.program.text():
         print(f"  as searched: {r.text}")
     if learned.parts:
-        print(f"learned in {len(learned.parts)} parts (nothing whole within the budget; rivals not searched):")
+        others = ("its rivals are the other joins of parts that fit" if len(learned.candidates()) > 1
+                  else "no other join of parts fits")
+        print(f"learned in {len(learned.parts)} parts (nothing whole within the budget; {others}):")
         for k, part in enumerate(learned.parts, 1):
             print(f"  part {k}: {part.text()}")
     print(f"explains {record['pairs_right']} of {record['pairs']} pairs")
@@ -214,8 +220,8 @@ def _report(learned, record: dict, out: Path) -> None:
             print(f"  {rv['label']}: {rv['program']}  ({where})")
         print(f"question: {out / 'query.png'} (and query.json): add its input with the output you mean as a pair, "
               "and learn again")
-    elif learned.parts:  # learned in parts: no rivals were searched (said above)
-        pass
+    elif learned.parts and len(learned.candidates()) == 1:
+        pass  # said above: no other join fits
     elif len(learned.candidates()) > 1:
         print(f"not ambiguous: the {len(learned.candidates()) - 1} other program(s) found that explain every pair "
               f"act alike on {n} fresh scenes")
