@@ -14,6 +14,26 @@ def test_run_concept_prints_before_and_after(capsys):
     assert "before" in out and "after" in out and out.strip().endswith("changed")
 
 
+def test_a_saved_concept_that_changes_nothing_runs_on_the_first_scene_it_runs_on(capsys, tmp_path, monkeypatch):
+    """A concept that never changes a table ("leave it as it is", learned as "grab the
+    star") is shown on the first seed it runs on, and says so, not on a seed it fails on."""
+    import numpy as np
+
+    from vccjax.machine.program import parse
+    from vccjax.machine.reference import run_reference
+    from vccjax.world.scenes import random_scene
+    from vccjax.world.user_concepts import save_concept
+
+    text = "scene_parse; set_shape_attn(star); top_down_attend; move_hand_to_attended_object; grab_object"
+    monkeypatch.setenv("VCC_LIBRARY", str(tmp_path))
+    save_concept("grab_star", {"program": text}, tmp_path)
+    scenes = [random_scene(np.random.default_rng(s), 4, pointer=True) for s in range(500)]  # as `vcc run` draws
+    runs = [s for s, scene in enumerate(scenes) if not run_reference(parse(text), scene).failed]
+    assert main(["run", "--concept", "grab_star", "--engine", "reference"]) == 0
+    out = capsys.readouterr().out
+    assert f"random scene, seed {runs[0]} (grab_star changes no scene of seeds 0 to 499; the first it runs on)" in out
+
+
 def test_run_reports_a_failing_program(capsys):
     assert main(["run", "scene_parse; release_object", "--engine", "reference"]) == 1
     assert "FAILED at instruction 1 (release_object): not holding an object" in capsys.readouterr().out
