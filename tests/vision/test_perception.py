@@ -91,7 +91,7 @@ def test_pictures_drawn_apart_from_our_renderer_are_parsed(style, size, width):
         assert got.pointer is not None and abs(got.pointer[0] - 0.85) < 0.02 and abs(got.pointer[1] - 0.15) < 0.02
 
 
-@pytest.mark.parametrize("style", ["schematic", "varied", "outline", "photo"])
+@pytest.mark.parametrize("style", ["schematic", "varied", "outline", "photo", "dark"])
 def test_a_pointer_on_an_object_is_found_and_the_object_keeps_its_shape(style):
     """As `attend_pointer` examples are drawn: the pointer's ring lies on an object (here
     the middle of a square, and the edge of a triangle, which the ring cuts in two)."""
@@ -105,7 +105,7 @@ def test_a_pointer_on_an_object_is_found_and_the_object_keeps_its_shape(style):
         assert got.pointer is not None and np.hypot(got.pointer[0] - pointer[0], got.pointer[1] - pointer[1]) < CFG.tau
 
 
-@pytest.mark.parametrize("style", ["schematic", "outline", "photo"])
+@pytest.mark.parametrize("style", ["schematic", "outline", "photo", "dark"])
 def test_two_touching_objects_of_one_colour_are_two_objects(style):
     """Side by side and touching, they make one region: no one shape fits it, and the cut
     that leaves two well-fitting parts gives them back."""
@@ -196,3 +196,20 @@ def test_a_fringe_of_specks_along_one_edge_leaves_a_square_square(side):
     assert [(o.shape, o.color) for o in got.objects] == [("square", "green")]
     o = got.objects[0]
     assert abs(o.x - (x0 + n / 2) / 384) < 0.01 and abs(o.y - (y0 + n / 2) / 384) < 0.01
+
+
+def test_scenes_on_a_dark_table_parse_exactly_with_no_phantom_pointer():
+    """A dark desk or a dark slide theme: the table, faintly tinted, is no blue object,
+    its darkness no outline, and no dark patch of it a pointer."""
+    from vccjax.vision.drawings import draw
+    from vccjax.world.scenes import random_scene
+
+    rng = np.random.default_rng(11)
+    for k in range(12):
+        sc = random_scene(rng, (2, 8), widths=(0.04, 0.20), pointer=bool(k % 2))
+        img = draw(sc, "dark", 256, seed=k)
+        table = np.median(img.reshape(-1, 3), 0)
+        assert table.max() < 80  # the drawing's table is dark
+        got = parse_image(img)
+        assert scenes_match(got, sc, CFG.tau), (k, got)
+        assert (got.pointer is None) == (sc.pointer is None), (k, got.pointer, sc.pointer)

@@ -6,7 +6,9 @@ Styles:
 - `outline`: flat fills with a black outline, as in a drawing program;
 - `jitter`: hand-drawn: every vertex (and a circle's rim) moved by up to 2% of the width;
 - `photo`: flat fills, then blur, sensor noise and JPEG compression;
-- `shades`: other shades of the four colours on a tinted background.
+- `shades`: other shades of the four colours on a tinted background;
+- `dark`: flat fills on a dark table (near black to slate), as on a dark desk or a
+  slide with a dark theme.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import numpy as np
 from vccjax.machine.geometry import shape_polygon
 from vccjax.machine.scene import Scene
 
-STYLES = ("outline", "jitter", "photo", "shades")
+STYLES = ("outline", "jitter", "photo", "shades", "dark")
 
 BASE = {"red": (214, 39, 40), "green": (44, 160, 44), "blue": (31, 119, 180), "yellow": (240, 200, 20)}
 SHADES = {  # a few other shades a person might pick for each colour
@@ -56,6 +58,9 @@ def draw(scene: Scene, style: str, size: int = 256, seed: int = 0) -> np.ndarray
     background = (255, 255, 255)
     if style == "shades":
         background = tuple(int(v) for v in rng.integers(228, 250, 3))
+    elif style == "dark":
+        grey = int(rng.integers(12, 60))
+        background = (grey, grey, grey + int(rng.integers(0, 16)))  # black to slate: a table, not a blue object
     img = Image.new("RGB", (big, big), background)
     pen = ImageDraw.Draw(img)
     for o in scene.objects:

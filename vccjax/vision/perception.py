@@ -21,6 +21,8 @@ from vccjax.machine.scene import Scene, SceneObject, to_units
 from vccjax.vision.grey_fit import GREY_FIT_MAX_PX, grey_fit
 from vccjax.vision.shape_fit import fit_shapes
 
+DARK_TABLE = 120  # a table whose median brightness (HSV value) is below this is dark (the arm camera's, dimmed: 160)
+DARK_TABLE_LIFT = 30  # on a dark table, colour counts this much brighter than the table
 # OpenCV hue (0..180) bands of the four colours; anything saturated outside them is unknown.
 HUE_BANDS = {"red": ((0, 10), (165, 180)), "yellow": ((18, 38),), "green": ((45, 88),), "blue": ((95, 135),)}
 
@@ -57,7 +59,15 @@ def parse_image(image: np.ndarray, options: ParseOptions = ParseOptions()) -> Sc
     luma = cv2.cvtColor(image, cv2.COLOR_RGB2GRAY)
     saturated = (hsv[..., 1] >= options.min_saturation) & (hsv[..., 2] >= options.min_value)
     faint = (hsv[..., 1] >= options.edge_saturation) & (hsv[..., 2] >= options.min_value // 2)
-    dark = hsv[..., 2] < options.outline_value
+    table = float(np.median(hsv[..., 2][~saturated])) if (~saturated).any() else 255.0
+    dark_table = table < DARK_TABLE
+    if dark_table:
+        # a dark desk, a slide's dark theme: a tinted dark table is faintly saturated
+        # itself, so colour counts only where it is brighter than the table; no outline
+        # can be told from the table, and no dark ring away from objects is a pointer
+        lit = hsv[..., 2] >= table + DARK_TABLE_LIFT
+        saturated, faint = saturated & lit, faint & lit
+    dark = (hsv[..., 2] < options.outline_value) & ~dark_table
     reach = max(1, int(round(options.outline_width * size_x)))
     ring = _pointer_ring(hsv)
     under_pointer = np.zeros(dark.shape, bool)
@@ -112,7 +122,8 @@ def parse_image(image: np.ndarray, options: ParseOptions = ParseOptions()) -> Sc
     if not objects:
         raise SceneError("no objects found in the image")
     objects.sort(key=lambda o: (o.y, o.x))  # a stable, image-independent order
-    pointer = (ring[0] / size_x, ring[1] / size_y) if ring is not None else _find_pointer(hsv, claimed)
+    pointer = (ring[0] / size_x, ring[1] / size_y) if ring is not None else \
+        None if dark_table else _find_pointer(hsv, claimed)
     return Scene(tuple(_clamp(o) for o in objects), pointer)
 
 
@@ -200,9 +211,11 @@ def _luma_points(shaped: np.ndarray, core: np.ndarray, luma: np.ndarray, others:
     if table.size == 0:
         return shaped
     bg, body = float(np.median(table)), float(np.median(luma[core]))
-    if bg - body < 24:
+    if abs(bg - body) < 24:
         return shaped  # too little contrast in brightness to follow
-    ink = (luma[y0:y1, x0:x1] <= bg - 0.45 * (bg - body)) & ~others[y0:y1, x0:x1]
+    # as far from the table as 45% of the way to the body: darker on a light table,
+    # lighter on a dark one
+    ink = ((bg - luma[y0:y1, x0:x1]) / (bg - body) >= 0.45) & ~others[y0:y1, x0:x1]
     out = shaped.copy()
     start = shaped[y0:y1, x0:x1] & ink
     if not start.any():
@@ -226,9 +239,9 @@ def _grey_refit(fit: tuple, luma: np.ndarray, core: np.ndarray, usable: np.ndarr
     if around.sum() < 16:
         return fit
     bg, body = float(np.median(grey[around])), float(np.median(luma[core]))
-    if bg - body < 24:
+    if abs(bg - body) < 24:
         return fit
-    darkness = np.clip((bg - grey) / (bg - body), -0.5, 3.0)
+    darkness = np.clip((bg - grey) / (bg - body), -0.5, 3.0)  # the object's share of each pixel, either contrast
     shape, cx, cy, width, _, _ = grey_fit(darkness, free, (x0 - xa, y0 - ya, x1 - xa, y1 - ya))
     return shape, cx + xa, cy + ya, width
 
