@@ -244,6 +244,7 @@ def run_command(parser: argparse.ArgumentParser, argv: list[str] | None = None,
     except SystemExit as e:  # a bad option (one line already printed), or --help
         return int(e.code or 0) if isinstance(e.code, int) or e.code is None else 2
     fn: Callable[[argparse.Namespace], int] = args.fn
+    before = _catch_interrupts()
     try:
         return int(fn(args) or 0)
     except USER_ERRORS as e:
@@ -262,6 +263,48 @@ def run_command(parser: argparse.ArgumentParser, argv: list[str] | None = None,
         print(f"{prog}: internal error (a bug, please report it): {type(e).__name__}: {str(e)[:200]}; "
               f"traceback saved to {save_traceback()}", file=sys.stderr)
         return 70
+    finally:
+        if before is not None:
+            import signal
+
+            signal.signal(signal.SIGINT, before)
+
+
+def _catch_interrupts():
+    """Ctrl-C as `on_interrupt` takes it, for the command's run; the handler it replaces
+    (None where signals cannot be set: not the main thread)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGINT, on_interrupt)
+
+
+def on_interrupt(signum: int, frame) -> None:
+    """Ctrl-C as KeyboardInterrupt, except where Python would print the exception and drop
+    it: inside a garbage-collector callback (JAX registers one) or an object's `__del__`.
+    The search then went on to its end and reported a verdict on a fraction of its
+    budget. There, the signal is sent again a moment later, when the callback is done."""
+    import gc
+
+    callbacks = {getattr(cb, "__code__", None) for cb in gc.callbacks}
+    f = frame
+    while f is not None:
+        if f.f_code in callbacks or f.f_code.co_name == "__del__":
+            send_again()
+            return
+        f = f.f_back
+    raise KeyboardInterrupt
+
+
+def send_again(delay: float = 0.05) -> None:
+    import signal
+    import threading
+
+    timer = threading.Timer(delay, os.kill, (os.getpid(), signal.SIGINT))
+    timer.daemon = True
+    timer.start()
 
 
 def save_traceback() -> str:

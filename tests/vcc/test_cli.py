@@ -140,6 +140,53 @@ def test_ctrl_c_is_one_line_and_exit_130(capsys):
     assert capsys.readouterr().err == "vcc: interrupted; rerun the same command to resume\n"
 
 
+def test_ctrl_c_inside_a_gc_callback_is_sent_again_not_lost(monkeypatch):
+    """Python drops an exception raised in a garbage-collector callback: Ctrl-C arriving
+    there is sent again a moment later; anywhere else it interrupts at once."""
+    import gc
+    import signal
+    import sys
+
+    import pytest
+
+    from vccjax import runtime
+
+    sent, seen = [], []
+    monkeypatch.setattr(runtime, "send_again", lambda: sent.append(True))
+
+    def callback(phase, info):
+        try:
+            runtime.on_interrupt(signal.SIGINT, sys._getframe())
+            seen.append("deferred")
+        except KeyboardInterrupt:
+            seen.append("raised")
+
+    gc.callbacks.append(callback)
+    try:
+        gc.collect()
+    finally:
+        gc.callbacks.remove(callback)
+    assert seen and set(seen) == {"deferred"} and len(sent) == len(seen)
+    with pytest.raises(KeyboardInterrupt):
+        runtime.on_interrupt(signal.SIGINT, sys._getframe())
+
+
+def test_a_command_takes_ctrl_c_by_its_handler_and_gives_the_old_one_back():
+    import signal
+
+    from vccjax import runtime
+
+    def command(a):
+        assert signal.getsignal(signal.SIGINT) is runtime.on_interrupt
+        return 0
+
+    before = signal.getsignal(signal.SIGINT)
+    parser = runtime.Parser(prog="vcc")
+    parser.set_defaults(fn=command)
+    assert runtime.run_command(parser, []) == 0
+    assert signal.getsignal(signal.SIGINT) is before
+
+
 def test_an_option_given_twice_is_refused_in_one_line(capsys):
     assert main(["run", "scene_parse", "--seed", "1", "--seed", "2"]) == 2
     err = capsys.readouterr().err
