@@ -98,6 +98,10 @@ def cmd_learn(a: argparse.Namespace) -> int:
     from vccjax.world.user_concepts import check_name, save_concept
 
     settings = _settings(a)
+    examples_dir, out_dir = Path(a.examples).resolve(), Path(a.out).resolve()
+    if out_dir == examples_dir or examples_dir in out_dir.parents:
+        raise VCCError(f"--out {a.out}: inside the examples folder {a.examples}, where its files would be read "
+                       f"as pairs next time; write it elsewhere")
     if a.save and not a.name:
         raise VCCError("--save needs --name NAME (the name to run the concept by)")
     if a.name:

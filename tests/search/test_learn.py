@@ -172,6 +172,7 @@ def _bad_cases(tmp_path, pairs):
                                       _blank(d / "0_in.png", (200, 0, 200))), "unknown color"),
         "object from nowhere": (lambda d: _folder(d, [(a, extra)]), "never makes one"),
         "shape changed": (lambda d: _folder(d, [(a, reshaped)]), "has no"),
+        "a file": (lambda d: d.write_text("x"), "not a folder of example pairs"),
         "empty table": (lambda d: _folder(d, [(Scene((), None), Scene((), None))]), "0_in.json: no objects"),
         "one input, two outputs": (lambda d: _folder(d, [(a, b), (a, a)]), "1_out.json: its input is 0_in.json's"),
         "more than the predictor reads": (lambda d: _folder(d, [(crowded, crowded)]),
@@ -181,7 +182,7 @@ def _bad_cases(tmp_path, pairs):
 
 @pytest.mark.parametrize("case", ["empty", "no such folder", "half a pair", "two inputs", "stray file", "bad json",
                                   "bad png", "no objects", "unknown colour", "object from nowhere", "shape changed",
-                                  "empty table", "one input, two outputs", "more than the predictor reads"])
+                                  "a file", "empty table", "one input, two outputs", "more than the predictor reads"])
 def test_bad_examples_are_refused_in_one_line_and_nothing_is_written(data, tmp_path, capsys, case):
     make, message = _bad_cases(tmp_path, data.pairs(CONCEPT, "train"))[case]
     folder, out = tmp_path / "ex", tmp_path / "out"
@@ -190,6 +191,16 @@ def test_bad_examples_are_refused_in_one_line_and_nothing_is_written(data, tmp_p
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1, err
     assert not out.exists()
+
+
+def test_an_out_folder_inside_the_examples_is_refused(data, tmp_path, capsys):
+    """Its files would be read as pairs on the next run."""
+    folder = _folder(tmp_path / "ex", data.pairs(CONCEPT, "train")[:2])
+    for out in (folder, folder / "out"):
+        assert main(["learn", str(folder), "--out", str(out), *QUICK]) == 2
+        err = capsys.readouterr().err.strip()
+        assert "inside the examples folder" in err and len(err.splitlines()) == 1, err
+    assert sorted(p.name for p in folder.iterdir()) == ["0_in.json", "0_out.json", "1_in.json", "1_out.json"]
 
 
 @pytest.mark.parametrize("flags, message", [

@@ -91,7 +91,7 @@ def pair_files(folder: str | Path) -> list[tuple[str, Path, Path]]:
     """(key, input file, output file) of every pair in `folder`, in natural key order."""
     folder = Path(folder)
     if not folder.is_dir():
-        raise VCCError(f"{folder}: no such examples folder")
+        raise VCCError(f"{folder}: {'not a folder of example pairs' if folder.exists() else 'no such examples folder'}")
     sides: dict[str, dict[str, Path]] = {}
     for path in sorted(folder.iterdir()):
         if path.name.startswith("."):
