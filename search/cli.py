@@ -11,7 +11,8 @@ from vccjax.world.concepts import concept_list
 
 
 def cmd_induce(a: argparse.Namespace) -> int:
-    from search.induce import Settings, induce, needs_answer, summary
+    from search.induce import Settings, induce, needs_answer
+    from search.run_summary import summary
     from vccjax.world.dataset import dataset_for
 
     runtime.on_cluster(a)

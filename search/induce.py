@@ -135,13 +135,14 @@ class Run:
             raise DataFileError(f"{self.out}: holds files but no run.json, so it is not a run to resume; "
                                 "use another --out")
         else:
-            info = {"format": "vccjax-induce", "version": 1}
-        info["settings"] = mine  # a resume may add the parts pass
+            info = {"format": "vccjax-induce", "version": 1, "settings": mine, "sessions": []}
+            self._write_meta(info)
         self.records = read_records(self.results_path)
-        drop_cut_tail(self.results_path)  # never a rewrite: a kill then would lose the run
-        info.setdefault("sessions", []).append(round(time.time(), 3))  # starts, for the wall time
-        self.session = len(info["sessions"]) - 1
-        self._write_meta(info)
+        # this session's start, for the wall time: written with its first record, so that
+        # a resume the checks below refuse (examples, weights, start model) or that has
+        # nothing left to do leaves run.json as it was
+        self._start: float | None = round(time.time(), 3)
+        self.session = len(info.get("sessions", []))
 
     def _meta(self) -> dict:
         """run.json, checked: an object of this format with its settings and sessions."""
@@ -217,6 +218,13 @@ class Run:
         return {r["concept"] for r in self.records if r["iteration"] == iteration}
 
     def append(self, record: dict) -> None:
+        if self._start is not None:  # the session's first record: its start and settings first
+            info = self._meta()
+            info["settings"] = dataclasses.asdict(self.settings)  # a resume may add the parts pass
+            info["sessions"].append(self._start)
+            self._write_meta(info)
+            drop_cut_tail(self.results_path)  # never a rewrite: a kill then would lose the run
+            self._start = None
         record = {**record, "session": self.session, "at": round(time.time(), 3)}
         self.records.append(record)
         append_line(self.results_path, record)
@@ -358,43 +366,3 @@ def model_sha256(vocab: Vocabulary, model: MarkovModel) -> str:
     h.update(np.ascontiguousarray(model.logp, np.float64).tobytes())
     return h.hexdigest()
 
-
-def wall_seconds(run: Run) -> float:
-    """The run's wall time over all its sessions: each from its start to its last record
-    (a session killed later loses only the time after that record)."""
-    starts = json.loads((run.out / "run.json").read_text()).get("sessions", [])
-    total = 0.0
-    for k, start in enumerate(starts):
-        ats = [r["at"] for r in run.records if r.get("session") == k and "at" in r]
-        total += max(ats) - start if ats else 0.0
-    return total
-
-
-def summary(run: Run, concepts: Sequence[str]) -> dict:
-    recs = [r for r in run.records if r["concept"] in set(concepts)]
-    found = {r["concept"]: r for r in recs if r["found"]}
-    spent = sum(r["seconds"] for r in recs)  # each concept's share of the lockstep rounds
-    secs = spent - sum(r.get("compile_seconds", 0.0) for r in recs)
-    covered = sum(r["covered"] for r in recs)
-    exact = sum(1 for r in found.values() if r["test_correct"] == r["test_total"])
-    return {
-        "concepts": len(set(concepts)), "found": len(found), "exact_on_all_test_pairs": exact,
-        # milliseconds kept: a short run whose steps were compiled earlier in the process
-        # searches for well under 0.05 s, which must not read as no time at all
-        "wall_seconds": round(wall_seconds(run), 3),
-        "search_seconds": round(secs, 3), "compile_seconds": round(spent - secs, 3),
-        "programs_covered": covered,
-        "programs_run": sum(r["programs_run"] for r in recs), "nodes": sum(r["nodes"] for r in recs),
-        "programs_per_second": round(covered / secs) if secs else None,
-        "programs_run_per_second": round(sum(r["programs_run"] for r in recs) / secs) if secs else None,
-        # what the same run with subroutines off finds: it stops where this one turns them on
-        "found_without_subroutines": sum(1 for r in found.values()
-                                         if not r.get("subroutines") and not r.get("last_pass")),
-        # the last pass after the iterations (`search.parts_pass`): found there, and in parts
-        "found_in_last_pass": sum(1 for r in found.values() if r.get("last_pass")),
-        "found_in_parts": sum(1 for r in found.values() if r.get("parts")),
-        "per_iteration": {
-            it: sum(1 for r in recs if r["iteration"] == it and r["found"])
-            for it in sorted({r["iteration"] for r in recs})
-        },
-    }

@@ -115,7 +115,7 @@ def oracle_line(others: Path | None) -> str:
             and m["settings"].get("budget") == 500_000]
     if not runs:
         return f"| {what} | not run | - |"
-    record = min(runs, key=lambda r: min(r[1].get("sessions", [0])))
+    record = min(runs, key=lambda r: min(r[1].get("sessions") or [0]))
     p, _, s = min(runs, key=lambda r: r[2]["wall_seconds"])
     ok = s["wall_seconds"] <= TARGETS["oracle_wall_s"] and s["found"] >= record[2]["found"]
     return (f"| {what} as the run of record (`{record[0]}`: {record[2]['found']}) | {s['found']} in "
@@ -128,7 +128,7 @@ def compile_line(folder: Path | None) -> str:
     runs = _runs(folder)
     if not runs:
         return f"| {what} | not run | - |"
-    p, _, s = max(runs, key=lambda r: max(r[1].get("sessions", [0])))
+    p, _, s = max(runs, key=lambda r: max(r[1].get("sessions") or [0]))
     return (f"| {what} | {s['compile_seconds']:.1f} s of a {s['wall_seconds']:.1f} s run (`{p}`) | "
             f"{_yes(s['compile_seconds'] <= TARGETS['compile_s'])} |")
 

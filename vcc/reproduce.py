@@ -106,7 +106,8 @@ def run_row(row: Row, concepts: Sequence[str], out: Path, scale: float, dataset:
     `width`) may be a `search.cluster.ClusterSearcher`: the same results, each concept's
     search does not depend on where it runs."""
     from search.explore import Explorer
-    from search.induce import induce, summary
+    from search.induce import induce
+    from search.run_summary import summary
     from vccjax.world.dataset import dataset_for
 
     names = concepts_of(row, concepts)
@@ -165,7 +166,8 @@ def set_last_pass_aside(out: Path) -> Path | None:
 def read_row(path: Path) -> dict | None:
     """A row folder's figures: its summary when the run finished, else what its records say
     so far (marked partial). None when the folder holds no run."""
-    from search.induce import Run, summary
+    from search.induce import Run
+    from search.run_summary import summary
 
     if not (path / "run.json").exists():
         return None

@@ -180,12 +180,14 @@ def test_interrupted_run_resumes_without_losing_or_redoing(ds, tmp_path):
     # the same folder with other settings is refused, not mixed
     with pytest.raises(DataFileError, match="other settings"):
         Run(out, Settings(budget=4000, args="oracle", max_iterations=2))
-    # ... and so are other examples (a rebuilt dataset), before anything is searched
-    other = CountingExplorer()
+    # ... and so are other examples (a rebuilt dataset), before anything is searched or
+    # written: run.json stays as it was (no session recorded for the refused resume)
+    other, meta = CountingExplorer(), (out / "run.json").read_bytes()
     with pytest.raises(DataFileError, match="other examples for remove_"):
         induce(SHORT, ds.pairs, out, settings, explorer=other, progress=False,
                examples_sha256=lambda c: "0" * 64 if c == SHORT[0] else ds.sha256(c))
     assert other.calls == [] and len((out / "results.jsonl").read_text().splitlines()) == len(run.records)
+    assert (out / "run.json").read_bytes() == meta
 
 
 def test_cli_induce_runs_and_reports(tmp_path, capsys, monkeypatch):
@@ -204,8 +206,8 @@ def test_cli_induce_runs_and_reports(tmp_path, capsys, monkeypatch):
     assert main(argv) == 0
     lines = (out / "results.jsonl").read_text().splitlines()
     assert len(lines) == 2
-    meta = json.loads((out / "run.json").read_text())
-    assert len(meta["sessions"]) == 2 and set(meta["examples_sha256"]) == {"remove_bottom_obj", "remove_top_obj"}
+    meta = json.loads((out / "run.json").read_text())  # the rerun had nothing to do: no session of its own
+    assert len(meta["sessions"]) == 1 and set(meta["examples_sha256"]) == {"remove_bottom_obj", "remove_top_obj"}
 
 
 @pytest.mark.parametrize("argv, msg", [

@@ -8,7 +8,8 @@ import json
 
 import pytest
 
-from search.induce import Settings, induce, read_records, summary
+from search.induce import Settings, induce, read_records
+from search.run_summary import summary
 from search.scalar import ScalarExplorer
 from vcc.cli import main
 from vccjax.errors import DataFileError
