@@ -138,7 +138,8 @@ def row_lines(rows: dict[str, dict]) -> list[str]:
     lines = []
     main = rows.get(rp.MAIN)
     what = (f"all 546, order 1, predicted + fixation, 0.5M: <= {TARGETS['main_wall_s'] // 3600} h, >= "
-            f"{TARGETS['main_found']} found (the paper: 526), right on all 50 test pairs for >= {TARGETS['main_exact']}")
+            f"{TARGETS['main_found']} found (the paper: 526), right on all 50 test pairs for >= "
+            f"{TARGETS['main_exact']}")
     if main and main.get("complete"):
         ok = (main["found"] >= TARGETS["main_found"] and main["exact_on_all_test_pairs"] >= TARGETS["main_exact"]
               and main["wall_seconds"] <= TARGETS["main_wall_s"])

@@ -34,10 +34,11 @@ def program_and_scene(a: argparse.Namespace):
         raise VCCError(f"give one of {', '.join(given)}, not several")
     if a.example is not None and not a.concept:
         raise VCCError("--example K takes the K-th example pair of --concept NAME")
+    from vccjax.vision.examples_folder import read_scene  # errors name the file
+
     if a.scene:
-        return program, Scene.load(a.scene).validate(cfg), f"scene {a.scene}", None
+        return program, read_scene(a.scene, cfg, image=False), f"scene {a.scene}", None
     if a.image:
-        from vccjax.vision.examples_folder import read_scene
 
         scene = read_scene(a.image, cfg, image=True)
         return program, scene, f"image {a.image} ({len(scene.objects)} objects parsed)", None
@@ -127,9 +128,13 @@ def cmd_trace(a: argparse.Namespace) -> int:
 def cmd_concepts(a: argparse.Namespace) -> int:
     from vccjax.world.concepts import all_concepts
 
+    shown = 0
     for name, p in all_concepts().items():
         if a.pattern is None or a.pattern.lower() in name.lower():
             print(f"{len(p):3d}  {name}")
+            shown += 1
+    if not shown:
+        print(f"no concept name contains {a.pattern!r} (vcc concepts alone lists all 546)")
     return 0
 
 

@@ -34,6 +34,14 @@ def test_a_saved_concept_that_changes_nothing_runs_on_the_first_scene_it_runs_on
     assert f"random scene, seed {runs[0]} (grab_star changes no scene of seeds 0 to 499; the first it runs on)" in out
 
 
+def test_concepts_says_when_no_name_matches(capsys):
+    assert main(["concepts", "no_concept_is_named_so"]) == 0
+    out = capsys.readouterr().out
+    assert out == "no concept name contains 'no_concept_is_named_so' (vcc concepts alone lists all 546)\n"
+    assert main(["concepts", "swap"]) == 0
+    assert "swap_locations" in capsys.readouterr().out
+
+
 def test_run_reports_a_failing_program(capsys):
     assert main(["run", "scene_parse; release_object", "--engine", "reference"]) == 1
     assert "FAILED at instruction 1 (release_object): not holding an object" in capsys.readouterr().out
@@ -81,7 +89,11 @@ def test_scene_sources_and_their_mistakes_are_one_line_errors(capsys, tmp_path):
     notjson = tmp_path / "notjson"
     notjson.mkdir()
     (notjson / "manifest.json").write_text("{")
+    far = tmp_path / "far.json"
+    far.write_text(json.dumps({"objects": [{"shape": "star", "color": "red", "x": 1.5, "y": 0.4, "width": 0.1}]}))
     cases = [
+        (["run", "scene_parse", "--scene", str(far)], f"{far}: object 0 (red star"),
+        (["run", "scene_parse", "--image", str(tmp_path)], f"{tmp_path}: not an image file"),
         (["run", "--concept", "swap_locations", "--image", str(tmp_path / "none.png")], "none.png: no such image file"),
         (["run", "--concept", "swap_locations", "--image", str(junk)], "not an image OpenCV can read"),
         (["run", "--concept", "swap_locations", "--image", str(blank)], "blank.png: no objects found in the image"),

@@ -36,7 +36,7 @@ def read_image(path: str | Path) -> np.ndarray:
 
     path = Path(path)
     if not path.is_file():
-        raise VCCError(f"{path}: no such image file")
+        raise VCCError(f"{path}: {'not an image file' if path.exists() else 'no such image file'}")
     try:
         img = cv2.imread(str(path), cv2.IMREAD_COLOR)
     except cv2.error as e:  # e.g. a header claiming more pixels than OpenCV will allocate
