@@ -10,6 +10,7 @@ from collections import Counter
 from pathlib import Path
 
 from vccjax import files, runtime
+from vccjax.errors import VCCError
 
 
 def stamp(a: argparse.Namespace, benchmark: str) -> dict:
@@ -239,6 +240,10 @@ def cmd_bench_reproduce(a: argparse.Namespace) -> int:
 def _write_report(a: argparse.Namespace, runs: Path) -> int:
     from vcc import report
 
+    for flag, path in (("--others", a.others), ("--robot", a.robot), ("--compiled", a.compiled)):
+        if path and not Path(path).is_dir():  # a typo would leave its tables out without a word
+            raise VCCError(f"{flag} {path}: {'not a folder' if Path(path).exists() else 'no such folder'} "
+                           f"(give '' to leave its tables out)")
     st = stamp(a, "reproduce")
     rows = report.collect_rows(runs)
     out = Path(a.out)
@@ -252,6 +257,9 @@ def _write_report(a: argparse.Namespace, runs: Path) -> int:
 
 
 def cmd_bench_report(a: argparse.Namespace) -> int:
+    if not Path(a.runs).is_dir():  # `vcc bench reproduce` makes it; a report of none would be empty
+        raise VCCError(f"--runs {a.runs}: {'not a folder' if Path(a.runs).exists() else 'no such folder'} "
+                       f"of row runs")
     return _write_report(a, Path(a.runs))
 
 

@@ -8,18 +8,17 @@ from pathlib import Path
 
 from vcc import reproduce as rp
 from vcc.report_targets import targets_section
-from vccjax.errors import DataFileError
+from vccjax.errors import DataFileError, read_json
 
 RULED, RAISED = "the objects acted on rule out", ", those the pairs point in raised"  # `--filters` said
 
 
 def _load(folder: Path) -> list[tuple[str, dict]]:
+    """The result files (JSON objects naming their benchmark) in `folder`; other JSON is
+    not ours and is passed over, a file that is not JSON is named in one error line."""
     out = []
     for f in sorted(folder.glob("*.json")):
-        try:
-            d = json.loads(f.read_text())
-        except (OSError, json.JSONDecodeError):
-            continue
+        d = read_json(f, DataFileError, "missing")
         if isinstance(d, dict) and "benchmark" in d:
             out.append((f.name, d))
     return out

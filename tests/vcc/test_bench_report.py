@@ -219,3 +219,28 @@ def test_a_row_says_how_its_predicted_arguments_were_taken():
                     "filters the objects acted on rule out dropped")
     assert _predicted({"args": "predicted", "fill": "gained", "filters": "acted+raised"}).endswith(
         "filters the objects acted on rule out dropped, those the pairs point in raised")
+
+
+def test_a_missing_folder_or_a_result_that_is_not_json_is_one_line_and_nothing_written(tmp_path, capsys):
+    """A typo in a folder would leave its tables out without a word (or, for --runs, make
+    an empty report over the committed one); a corrupt result file is named."""
+    res = tmp_path / "res"
+    res.mkdir()
+    report = tmp_path / "REPORT.md"
+    base = ["bench", "report", "--out", str(res / "r.json"), "--report", str(report)]
+    cases = [
+        ([*base, "--runs", str(tmp_path / "typo")], f"--runs {tmp_path / 'typo'}: no such folder of row runs"),
+        ([*base, "--runs", str(tmp_path), "--others", str(tmp_path / "no")], f"--others {tmp_path / 'no'}: no such"),
+        ([*base, "--runs", str(tmp_path), "--robot", str(report.parent / "x.md")], "--robot"),
+        ([*base, "--runs", str(tmp_path), "--compiled", str(tmp_path / "no")], "--compiled"),
+    ]
+    for argv, message in cases:
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert message in err and err.count("\n") == 1, err
+    (res / "broken.json").write_text("{")
+    (res / "foreign.json").write_text(json.dumps({"not": "a result"}))  # valid JSON, not ours: passed over
+    assert main([*base, "--runs", str(tmp_path), "--others", "", "--robot", "", "--compiled", ""]) == 2
+    err = capsys.readouterr().err
+    assert f"{res / 'broken.json'}: not JSON" in err and err.count("\n") == 1, err
+    assert not report.exists() and not (res / "r.json").exists()
