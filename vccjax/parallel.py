@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import multiprocessing
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 
 
 def map_with_progress(fn: Callable, jobs: Sequence, workers: int, chunksize: int, desc: str,
@@ -17,12 +16,27 @@ def map_with_progress(fn: Callable, jobs: Sequence, workers: int, chunksize: int
     results = []
     with tqdm(total=len(jobs), desc=desc, unit=unit, disable=not progress) as bar:
         if workers > 1:
-            with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-                for r in pool.map(fn, jobs, chunksize=chunksize):
+            pool = multiprocessing.get_context("spawn").Pool(workers, initializer=_leave_ctrl_c_to_the_parent)
+            try:
+                for r in pool.imap(fn, jobs, chunksize=chunksize):
                     results.append(r)
                     bar.update()
+                pool.close()
+            except BaseException:  # Ctrl-C (or a job's error): the workers stop now, not after their jobs
+                pool.terminate()
+                raise
+            finally:
+                pool.join()
         else:
             for job in jobs:
                 results.append(fn(job))
                 bar.update()
     return results
+
+
+def _leave_ctrl_c_to_the_parent() -> None:
+    """A worker ignores Ctrl-C (the terminal sends it to the whole group): the parent
+    takes it, stops the workers and says so in one line."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
