@@ -183,8 +183,9 @@ def add_commands(sub) -> None:
                                  "shipped weights.")
     t.add_argument("--out", default="argpred-weights.msgpack", type=runtime.out_file(".msgpack"),
                    help="weights file (default argpred-weights.msgpack)")
-    t.add_argument("--data", help=f"data folder (default {DEFAULT_DATA}/seedS-N), or several built ones, "
-                                  "comma-separated, to train on together")
+    t.add_argument("--data", help=f"data folder (default {DEFAULT_DATA}/seedS-N; built there, or its build "
+                                  "resumed, when it is not complete), or several built ones, comma-separated, "
+                                  "to train on together")
     t.add_argument("--programs", type=runtime.count(1, 10**7), default=None,
                    help="training programs (default: all of an existing --data folder, else 1000)")
     t.add_argument("--epochs", type=runtime.count(1, 10**5), default=30)

@@ -149,7 +149,9 @@ def cmd_dataset_build(a: argparse.Namespace) -> int:
     programs = read_programs(a.programs) if a.programs else None
     start = time.time()
     m = build_dataset(a.out, concepts, seed=a.seed, workers=a.workers or os.cpu_count() or 1, programs=programs)
-    print(f"{len(m['concepts'])} concepts written to {a.out} (seed {a.seed}) in {time.time() - start:.0f}s")
+    asked = len(concepts) if concepts is not None else len(programs) if programs is not None else len(m["concepts"])
+    print(f"{asked} concept(s) built or found intact in {a.out} (seed {a.seed}) in {time.time() - start:.0f}s; "
+          f"the dataset holds {len(m['concepts'])}")
     left = m["rivals_left"]
     print(f"training pairs tell every rival of the reference apart in {len(m['concepts']) - len(left)} concepts;"
           f" {len(left)} leave some untold (manifest.json: rivals_left)")

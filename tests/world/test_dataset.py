@@ -222,3 +222,21 @@ def test_image_pairs_render_both_sides(small):
     assert a.shape == b.shape == (128, 128, 3) and a.dtype == np.uint8 and not np.array_equal(a, b)
     again = render_pairs(ds.pairs(SOME[0], "train"), style="schematic", size=128)
     assert all(np.array_equal(x, y) for p, q in zip(pairs, again) for x, y in zip(p, q))
+
+
+def test_adding_to_a_dataset_with_a_damaged_file_is_refused_before_anything_is_written(tmp_path):
+    """The manifest written after a build vouches for every file it lists: a kept file
+    that is damaged is named, and the folder is left as it was."""
+    import shutil
+
+    shutil.copytree(shipped_folder(), tmp_path / "ds")
+    manifest = json.loads((tmp_path / "ds" / "manifest.json").read_text())
+    victim, other = sorted(manifest["concepts"])[:2]
+    path = tmp_path / "ds" / manifest["concepts"][victim]["file"]
+    data = bytearray(path.read_bytes())
+    data[len(data) // 2] ^= 0xFF
+    path.write_bytes(bytes(data))
+    before = {p.name: p.read_bytes() for p in (tmp_path / "ds").iterdir()}
+    with pytest.raises(DataFileError, match=f"{path.name}: sha256 differs from the manifest.*--concepts {victim}"):
+        build_dataset(tmp_path / "ds", [other], seed=0, workers=1, progress=False)
+    assert {p.name: p.read_bytes() for p in (tmp_path / "ds").iterdir()} == before

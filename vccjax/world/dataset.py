@@ -264,7 +264,13 @@ def _kept_entries(out: Path, head: dict, rebuilt: set[str]) -> dict:
     if {k: old.get(k) for k in head} != head:
         raise DataFileError(f"{path}: this folder holds a dataset of another seed, world or format; "
                             "use another --out")
-    return {k: {n: v for n, v in old.get(k, {}).items() if n not in rebuilt} for k in empty}
+    kept = {k: {n: v for n, v in old.get(k, {}).items() if n not in rebuilt} for k in empty}
+    for name, entry in kept["concepts"].items():  # a manifest written now vouches for every file it lists
+        f = out / entry["file"]
+        if not f.is_file() or hashlib.sha256(f.read_bytes()).hexdigest() != entry["sha256"]:
+            raise DataFileError(f"{f}: {'missing' if not f.is_file() else 'sha256 differs from the manifest'}; "
+                                f"build it again (--concepts {name}) before adding to this dataset")
+    return kept
 
 
 def rival_warnings(manifest: dict) -> list[str]:
