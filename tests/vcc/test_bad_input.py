@@ -34,6 +34,11 @@ from vccjax.machine.state import load_scene
          ["instruction 2", "reset_attn inside a loop"]),
         ("scene_parse; loop_start; top_down_attend; fill_color(red); loop_end",
          ["instruction 4", "lacks next_object"]),
+        # a program file: the line too, counted with comments and blank lines
+        ("scene_parse\n# recolour it\n\ntop_down_attend\nfill_color(purple)\n",
+         ["instruction 2 (line 5)", "purple"]),
+        ("scene_parse\nfoo(\n", ["instruction 1 (line 2)", "cannot parse"]),
+        ("scene_parse; top_down_attend\nloop_end", ["instruction 2 (line 2)", "without loop_start"]),
     ],
 )
 def test_malformed_program_text(text, words):
@@ -41,6 +46,10 @@ def test_malformed_program_text(text, words):
         parse(text)
     for w in words:
         assert w in str(e.value), (w, str(e.value))
+
+
+def test_a_byte_order_mark_is_not_part_of_the_first_instruction():
+    assert parse("\ufeffscene_parse; top_down_attend") == parse("scene_parse; top_down_attend")
 
 
 def test_long_loop_body_is_refused_when_a_limit_is_given():

@@ -169,30 +169,45 @@ def parse(
 ) -> Program:
     """Parse the text form of docs/vcc.md section 6 (';' or newline separated, `name` or `name(arg)`).
 
-    Lines starting with '#' are comments. Errors name the instruction's position.
+    Lines starting with '#' are comments. Errors name the instruction's position, and in
+    a text of several lines (a program file) its line too.
     """
     items: list[tuple[str, list[str]]] = []
-    chunks = [c for line in text.splitlines() if not line.strip().startswith("#")
-              for c in line.split(";")]
-    for raw in chunks:
-        if not raw.strip():
-            continue
-        m = _ITEM.match(raw)
-        if not m:
-            raise ProgramSyntaxError(f"instruction {len(items)}: cannot parse {raw.strip()!r}")
-        name, argtext = m.group(1), m.group(2)
-        args = [] if argtext is None else [a.strip() for a in argtext.split(",")]
-        if args == [""]:
-            args = []
-        if any(not a for a in args):
-            raise ProgramSyntaxError(f"instruction {len(items)}: empty argument in {raw.strip()!r}")
-        items.append((name, args))
-    if not items:
-        raise ProgramSyntaxError("empty program")
-    program = expand(items, library)
-    if check_loops:
-        check_loop_syntax(program, complete=True, body_max=body_max)
+    lines: list[int] = []  # each item's line, from 1
+    chunks = [(n, c) for n, line in enumerate(text.removeprefix("\ufeff").splitlines(), 1)
+              if not line.strip().startswith("#") for c in line.split(";")]
+    try:
+        for n, raw in chunks:
+            if not raw.strip():
+                continue
+            lines.append(n)
+            m = _ITEM.match(raw)
+            if not m:
+                raise ProgramSyntaxError(f"instruction {len(items)}: cannot parse {raw.strip()!r}")
+            name, argtext = m.group(1), m.group(2)
+            args = [] if argtext is None else [a.strip() for a in argtext.split(",")]
+            if args == [""]:
+                args = []
+            if any(not a for a in args):
+                raise ProgramSyntaxError(f"instruction {len(items)}: empty argument in {raw.strip()!r}")
+            items.append((name, args))
+        if not items:
+            raise ProgramSyntaxError("empty program")
+        program = expand(items, library)
+        if check_loops:
+            check_loop_syntax(program, complete=True, body_max=body_max)
+    except ProgramSyntaxError as e:
+        raise ProgramSyntaxError(_with_line(str(e), lines if "\n" in text.strip() and not library else [])) from None
     return program
+
+
+def _with_line(message: str, lines: Sequence[int]) -> str:
+    """"instruction K: ..." as "instruction K (line N): ..." where the K-th item's line is
+    known (a subroutine's atoms are not items, so a library's programs keep K alone)."""
+    m = re.match(r"instruction (\d+):", message)
+    if m is None or int(m.group(1)) >= len(lines):
+        return message
+    return f"instruction {m.group(1)} (line {lines[int(m.group(1))]}):{message[m.end():]}"
 
 
 def check_loop_syntax(program: Program, *, complete: bool = True, body_max: int | None = None) -> None:
