@@ -247,15 +247,15 @@ def run_command(parser: argparse.ArgumentParser, argv: list[str] | None = None,
     before = _catch_interrupts()
     try:
         return int(fn(args) or 0)
+    except BrokenPipeError:  # the reader went away (`vcc concepts | head`): nothing to say (an OSError,
+        _quiet_stdout()      # so taken before USER_ERRORS)
+        return 0
     except USER_ERRORS as e:
         print(f"{prog}: error: {error_line(e)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"{prog}: interrupted; rerun the same command to resume", file=sys.stderr)
         return 130
-    except BrokenPipeError:  # the reader went away (`vcc concepts | head`): nothing to say
-        sys.stderr.close()
-        return 0
     except MemoryError:
         print(f"{prog}: error: out of memory; try smaller sizes or counts", file=sys.stderr)
         return 2
@@ -268,6 +268,17 @@ def run_command(parser: argparse.ArgumentParser, argv: list[str] | None = None,
             import signal
 
             signal.signal(signal.SIGINT, before)
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at /dev/null: the reader of the pipe is gone, and Python's flush at
+    exit would otherwise fail on it again and print that it did."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):  # stdout is no file (a test's capture): nothing to quiet
+        pass
 
 
 def _catch_interrupts():
@@ -333,6 +344,8 @@ def program_from_arg(text: str):
 
     looks_like_path = len(text) < 256 and "\n" not in text and ";" not in text
     path = Path(text) if looks_like_path else None
+    if path is not None and path.is_dir():
+        raise VCCError(f"{path}: a folder, not a program (give its text, or a .vcc file)")
     if path is not None and (text.endswith((".vcc", ".txt")) or path.is_file()):
         if not path.is_file():
             raise VCCError(f"{path}: no such program file")

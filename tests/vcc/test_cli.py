@@ -94,6 +94,7 @@ def test_scene_sources_and_their_mistakes_are_one_line_errors(capsys, tmp_path):
     cases = [
         (["run", "scene_parse", "--scene", str(far)], f"{far}: object 0 (red star"),
         (["run", "scene_parse", "--image", str(tmp_path)], f"{tmp_path}: not an image file"),
+        (["run", str(tmp_path)], f"{tmp_path}: a folder, not a program"),
         (["run", "--concept", "swap_locations", "--image", str(tmp_path / "none.png")], "none.png: no such image file"),
         (["run", "--concept", "swap_locations", "--image", str(junk)], "not an image OpenCV can read"),
         (["run", "--concept", "swap_locations", "--image", str(blank)], "blank.png: no objects found in the image"),
@@ -197,6 +198,20 @@ def test_a_command_takes_ctrl_c_by_its_handler_and_gives_the_old_one_back():
     parser.set_defaults(fn=command)
     assert runtime.run_command(parser, []) == 0
     assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_a_reader_that_goes_away_ends_the_command_quietly(capsys):
+    """`vcc concepts | head`: the pipe's reader closes early; that is no error (a
+    BrokenPipeError is an OSError, which bad input also raises)."""
+    from vccjax import runtime
+
+    def piped(a):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    parser = runtime.Parser(prog="vcc")
+    parser.set_defaults(fn=piped)
+    assert runtime.run_command(parser, []) == 0
+    assert capsys.readouterr().err == ""
 
 
 def test_an_option_given_twice_is_refused_in_one_line(capsys):
