@@ -127,10 +127,11 @@ class Run:
         if meta.exists():
             info = self._meta()
             if not same_search(info.get("settings"), mine):
-                raise DataFileError(
-                    f"{meta}: this folder holds a run with other settings {info.get('settings')}; "
-                    "use another --out or the same settings to resume"
-                )
+                old = info.get("settings") if isinstance(info.get("settings"), dict) else {}
+                differ = ", ".join(f"{k} {old.get(k)!r} (now {mine.get(k)!r})" for k in sorted(set(old) | set(mine))
+                                   if k != "parts" and old.get(k) != mine.get(k))
+                raise DataFileError(f"{meta}: this folder holds a run with other settings ({differ or old}); "
+                                    "use another --out or the same settings to resume")
         elif self.out.is_dir() and any(not f.name.startswith(".") for f in self.out.iterdir()):
             raise DataFileError(f"{self.out}: holds files but no run.json, so it is not a run to resume; "
                                 "use another --out")
