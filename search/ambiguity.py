@@ -146,9 +146,10 @@ def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int 
     lengths) by behaviour on fresh scenes like `inputs`, decide whether the examples are
     ambiguous, and pick the query: the fresh scene whose answer most probably leaves the
     right program as the cheapest one that fits, that is with the largest sum, over its
-    outcome groups, of the group's most probable member; ties go to fewer objects. The
-    query is a scene the first program runs on, or, where its failures make the examples
-    ambiguous, any fresh scene (a failure is then one outcome among the others).
+    outcome groups, of the group's most probable member; ties go to a scene the first runs
+    on, then to fewer objects. The query is a scene the first program runs on, or, where
+    its failures make the examples ambiguous, any fresh scene (a failure is then one
+    outcome among the others).
 
     The answer keeps one outcome group, and learning again keeps its cheapest program; if
     the right program is in that group, it is kept exactly when it is the group's most
@@ -176,7 +177,7 @@ def judge(candidates: Sequence[Program], inputs: Sequence[Scene], n_scenes: int 
         def rank(j: int) -> tuple:
             groups = groups_of([runs[k][j] for k in kept], tau)
             kept_right = sum(max(weight[kept[i]] for i in g) for g in groups)
-            return (-kept_right, len(scenes[j].objects), j)
+            return (-kept_right, first[j] is None, len(scenes[j].objects), j)  # at a tie, one it runs on
 
         usable = [j for j in range(len(scenes)) if first[j] is not None or by_domain]
         query = min(usable, key=rank)

@@ -175,6 +175,29 @@ def with_rivals(first: Result, chain: Chain, task: Task, settings: LearnSettings
                                compile_seconds=first.compile_seconds + again.compile_seconds)
 
 
+def with_each_or_one(result: Result, chain: Chain, pairs: Sequence[tuple[Scene, Scene]],
+                     settings: LearnSettings) -> Result:
+    """`result` with the learned program's each-or-one variants (`search.each_or_one`:
+    "every square" beside "the square") that explain every pair as rivals, first among
+    them: the rival pass finds them only within its margin, and a loop is rarely that
+    cheap. Not where the rival search is off (`rival_budget` 0)."""
+    from search.each_or_one import variants
+    from search.induce import generalization
+
+    if not result.found or settings.rival_budget == 0:
+        return result
+    have = {result.program} | {a.program for a in result.alternatives}
+    extra = []
+    for v in variants(result.program):
+        spelt = None if v in have or generalization(v, pairs, DEFAULT_CONFIG.tau) < len(pairs) \
+            else chain.cheapest(v.ops, v.args)
+        if spelt is not None:  # it fits every pair, and its arguments are ones the chain believes in
+            extra.append(Alternative(v, text_of(chain, spelt[1]), float(spelt[0])))
+    if not extra:
+        return result
+    return dataclasses.replace(result, alternatives=(*extra, *result.alternatives)[: settings.max_rivals - 1])
+
+
 def verdict_for(result: Result, pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings
                 ) -> tuple[Verdict | None, list[Scene]]:
     if not result.found:
@@ -304,5 +327,6 @@ def learn(pairs: Sequence[tuple[Scene, Scene]], settings: LearnSettings, searche
         chain, name = uniform, "uniform"
     first, parts = in_parts(first, pairs, settings, searcher, start, log)
     result = first if parts else with_rivals(first, chain, task, settings, searcher, progress, [a for a, _ in pairs])
+    result = with_each_or_one(result, chain, pairs, settings)
     verdict, scenes = verdict_for(result, pairs, settings)
     return Learned(result, name, verdict, scenes, parts)
