@@ -40,9 +40,11 @@ STARTS = ("library", "uniform")
 # 7: filter values the objects acted on rule out dropped (`argpred.acted`); 8: first parts
 # continued once more with a fixation added (`search.parts.remembering`); 9: filter values
 # the pairs point in raised (`argpred.acted`, `--filters acted+raised`); 10: searches for a
-# first part of more progress than those kept (`search.parts.first_parts`)
+# first part of more progress than those kept (`search.parts.first_parts`); 11: the first
+# program failing where a rival runs is ambiguity too (`search.ambiguity`), and the program's
+# each-or-one variants join the rivals (`search.each_or_one`)
 # (a run of another protocol is refused)
-PROTOCOL = 10
+PROTOCOL = 11
 # What every results line must hold (the key of `_key`, and whether it was found).
 RECORD_SCHEMA = {"kind": (str,), "concept": (str,), "examples": (int,), "start": (str,), "found": (bool,)}
 

@@ -102,13 +102,14 @@ def parse_image(image: np.ndarray, options: ParseOptions = ParseOptions()) -> Sc
             # the shape is judged on the half-saturation contour (the faint skirt fills a
             # star's notches and rounds corners), outlines kept, then on brightness
             half = hsv[..., 1] >= 0.5 * np.median(hsv[..., 1][labels == k])
-            shaped = _luma_points(region & (half | dark), labels == k, luma, ~mine | (saturated & ~hue), reach)
+            shaped = _luma_points(region & (half | dark), labels == k, luma, ~mine | (saturated & ~hue), reach,
+                                  dark_table)
             ys, xs = np.nonzero(shaped)
             x0, y0, x1, y1 = xs.min(), ys.min(), xs.max() + 1, ys.max() + 1
             fits = fit_shapes(shaped[y0:y1, x0:x1], x0, y0)
             if options.grey_fit and len(fits) == 1 and max(x1 - x0, y1 - y0) <= GREY_FIT_MAX_PX:
                 fits = [_grey_refit(fits[0], luma, labels == k, mine & ~(saturated & ~hue) & ~under_pointer,
-                                    (x0, y0, x1, y1), reach)]
+                                    (x0, y0, x1, y1), reach, dark_table)]
             for shape, cx, cy, width in fits:
                 objects.append(SceneObject(shape, color, cx / size_x, cy / size_y, width / size_x))
     leftover = saturated & ~claimed
@@ -196,9 +197,10 @@ def _grown(seed: np.ndarray, faint: np.ndarray, dark: np.ndarray, reach: int) ->
 
 
 def _luma_points(shaped: np.ndarray, core: np.ndarray, luma: np.ndarray, others: np.ndarray,
-                 reach: int) -> np.ndarray:
-    """`shaped` grown into the connected pixels darker than the table around it by 45% of
-    the core's contrast (a little under half, so a small square's soft corners stay).
+                 reach: int, dark_table: bool = False) -> np.ndarray:
+    """`shaped` grown into the connected pixels darker than the table around it (lighter, on
+    a dark table) by 45% of the core's contrast (a little under half, so a small square's
+    soft corners stay).
     JPEG keeps brightness at full resolution but colour at half, so a small star's
     blurred points still show in brightness when their colour is gone. Pixels nearer
     another region, or of another colour's object, are never taken."""
@@ -211,8 +213,8 @@ def _luma_points(shaped: np.ndarray, core: np.ndarray, luma: np.ndarray, others:
     if table.size == 0:
         return shaped
     bg, body = float(np.median(table)), float(np.median(luma[core]))
-    if abs(bg - body) < 24:
-        return shaped  # too little contrast in brightness to follow
+    if (body - bg if dark_table else bg - body) < 24:
+        return shaped  # too little contrast in brightness to follow (a yellow object on a grey table)
     # as far from the table as 45% of the way to the body: darker on a light table,
     # lighter on a dark one
     ink = ((bg - luma[y0:y1, x0:x1]) / (bg - body) >= 0.45) & ~others[y0:y1, x0:x1]
@@ -225,7 +227,7 @@ def _luma_points(shaped: np.ndarray, core: np.ndarray, luma: np.ndarray, others:
 
 
 def _grey_refit(fit: tuple, luma: np.ndarray, core: np.ndarray, usable: np.ndarray,
-                box: tuple[int, int, int, int], reach: int) -> tuple:
+                box: tuple[int, int, int, int], reach: int, dark_table: bool = False) -> tuple:
     """A small object's shape, centre and width from its grey levels (`grey_fit`), in
     place of the region's fit; the region's fit stands where brightness says too little."""
     x0, y0, x1, y1 = box
@@ -239,7 +241,7 @@ def _grey_refit(fit: tuple, luma: np.ndarray, core: np.ndarray, usable: np.ndarr
     if around.sum() < 16:
         return fit
     bg, body = float(np.median(grey[around])), float(np.median(luma[core]))
-    if abs(bg - body) < 24:
+    if (body - bg if dark_table else bg - body) < 24:
         return fit
     darkness = np.clip((bg - grey) / (bg - body), -0.5, 3.0)  # the object's share of each pixel, either contrast
     shape, cx, cy, width, _, _ = grey_fit(darkness, free, (x0 - xa, y0 - ya, x1 - xa, y1 - ya))
