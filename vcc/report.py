@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 from vcc import reproduce as rp
-from vcc.report_targets import targets_section
+from vcc.report_targets import by_date, targets_section
 from vccjax.errors import DataFileError, read_json
 
 RULED, RAISED = "the objects acted on rule out", ", those the pairs point in raised"  # `--filters` said
@@ -31,12 +31,8 @@ def _stamp(name: str, d: dict) -> str:
             f"command `{d.get('command', '?')}`")
 
 
-def _latest(results: list[tuple[str, dict]], kind: str) -> list[tuple[str, dict]]:
-    return sorted([r for r in results if r[1]["benchmark"] == kind], key=lambda r: r[1].get("date", ""))
-
-
 def emulator_section(results: list[tuple[str, dict]]) -> list[str]:
-    runs = _latest(results, "emulator")
+    runs = by_date(results, "emulator")
     if not runs:
         return ["## Emulator", "", "Not run (`vcc bench emulator`).", ""]
     lines = ["## Emulator: batched JAX vs the reference interpreter, same stream, same run", ""]
@@ -57,7 +53,7 @@ def emulator_section(results: list[tuple[str, dict]]) -> list[str]:
 
 
 def search_section(results: list[tuple[str, dict]]) -> list[str]:
-    runs = _latest(results, "search")
+    runs = by_date(results, "search")
     if not runs:
         return ["## Search", "", "Not run (`vcc bench search`).", ""]
     lines = ["## Search: batched vs scalar-driven, same concepts, same run", "",
@@ -226,7 +222,7 @@ def stress_section(folder: Path) -> list[str]:
 
 def cluster_section(results: list[tuple[str, dict]]) -> list[str]:
     """One process against Ray workers on the same search (`vcc bench cluster`)."""
-    runs = _latest(results, "cluster")
+    runs = by_date(results, "cluster")
     if not runs:
         return []
     lines = ["## Explore-compress on Ray workers (`vcc bench cluster`)", "",
@@ -241,7 +237,7 @@ def cluster_section(results: list[tuple[str, dict]]) -> list[str]:
 
 def camera_section(results: list[tuple[str, dict]]) -> list[str]:
     """The arm camera's parse against the true tables (`vcc robot perception`), per condition."""
-    runs = _latest(results, "robot-perception")
+    runs = by_date(results, "robot-perception")
     if not runs:
         return []
     name, d = runs[-1]
@@ -256,7 +252,7 @@ def camera_section(results: list[tuple[str, dict]]) -> list[str]:
 def learn_section(results: list[tuple[str, dict]]) -> list[str]:
     """New concepts learned from their pairs (`vcc bench learn`): the library against from
     scratch, the questions asked back, and `vcc learn`'s wall time cold and warm."""
-    runs = _latest(results, "learn")
+    runs = by_date(results, "learn")
     if not runs:
         return []
     name, d = runs[-1]
@@ -285,7 +281,7 @@ def argpred_section(results: list[tuple[str, dict]]) -> list[str]:
     """The argument predictor's recall and sharpness (`vcc argpred eval`): concepts whose
     used arguments all pass the threshold, and the arguments passed that a concept never
     uses, per function (each widens the search)."""
-    runs = _latest(results, "argpred-recall")
+    runs = by_date(results, "argpred-recall")
     if not runs:
         return []
     lines = ["## Argument predictor: recall and extra arguments (`vcc argpred eval`)", "",

@@ -21,14 +21,15 @@ def _yes(ok: bool) -> str:
     return "yes" if ok else "no"
 
 
-def _by_date(results: list[tuple[str, dict]], kind: str) -> list[tuple[str, dict]]:
+def by_date(results: list[tuple[str, dict]], kind: str) -> list[tuple[str, dict]]:
+    """The result files of one benchmark, oldest first (the report's tables read them too)."""
     return sorted([r for r in results if r[1]["benchmark"] == kind], key=lambda r: r[1].get("date", ""))
 
 
 def emulator_lines(results: list[tuple[str, dict]]) -> list[str]:
     """The latest emulator file: its main ratio, its slowest common instruction and its
     finest raster."""
-    emu = _by_date(results, "emulator")
+    emu = by_date(results, "emulator")
     if not emu:
         return ["| JAX emulator >= 20x | not run | - |"]
     name, d = emu[-1]
@@ -57,7 +58,7 @@ def search_lines(results: list[tuple[str, dict]]) -> list[str]:
     """The first specification's line (the best run-to-the-end rate of any search file),
     then the learned library's benchmark: judged on its latest one-device file, the
     default setting; the best of any file and setting named beside it."""
-    srch = _by_date(results, "search")
+    srch = by_date(results, "search")
     if not srch:
         return ["| search >= 25,000 programs/s | not run | - |"]
     best = max(srch, key=lambda x: x[1]["batched"]["programs_run"] / x[1]["batched"]["seconds"])
